@@ -1,0 +1,11 @@
+// hairvox CLI: one registration function per subcommand.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace hairvox::cli {
+
+void addGenerateCommand(CLI::App& app);
+void addInfoCommand(CLI::App& app);
+
+} // namespace hairvox::cli

@@ -1,0 +1,42 @@
+# Strict warnings and sanitizers, applied per target with hairvox_target_defaults().
+# (OpenVDB's cmake/config/OpenVDBCXX.cmake and cpp-best-practices are the models.)
+
+set(HAIRVOX_WARNINGS
+    -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wsign-conversion
+    -Wdouble-promotion -Wnon-virtual-dtor -Wold-style-cast -Woverloaded-virtual
+    -Wimplicit-fallthrough -Wformat=2 -Wcast-align -Wmissing-declarations)
+if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+    list(APPEND HAIRVOX_WARNINGS -Wduplicated-cond -Wlogical-op -Wuseless-cast)
+endif()
+
+if(HAIRVOX_SANITIZE)
+    string(REPLACE "," ";" _hairvox_sanitizers "${HAIRVOX_SANITIZE}")
+    foreach(s IN LISTS _hairvox_sanitizers)
+        if(NOT s MATCHES "^(address|undefined|thread|leak)$")
+            message(FATAL_ERROR "HAIRVOX_SANITIZE: unknown sanitizer '${s}'")
+        endif()
+    endforeach()
+    set(HAIRVOX_SANITIZE_FLAGS -fsanitize=${HAIRVOX_SANITIZE} -fno-omit-frame-pointer
+        -fno-sanitize-recover=all)
+    add_compile_options(${HAIRVOX_SANITIZE_FLAGS})
+    add_link_options(${HAIRVOX_SANITIZE_FLAGS})
+endif()
+
+# Apply hairvox's warning set to one of its own targets (never to dependencies).
+function(hairvox_target_defaults target)
+    target_compile_options(${target} PRIVATE ${HAIRVOX_WARNINGS})
+    if(HAIRVOX_WERROR)
+        target_compile_options(${target} PRIVATE -Werror)
+    endif()
+endfunction()
+
+# hairvox_add_library(name SOURCES ... DEPS ...): one static library per stage,
+# exposing <stage>/include so that only linked stages can include its headers.
+function(hairvox_add_library name)
+    cmake_parse_arguments(ARG "" "" "SOURCES;PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
+    add_library(hairvox_${name} STATIC ${ARG_SOURCES})
+    add_library(hairvox::${name} ALIAS hairvox_${name})
+    target_include_directories(hairvox_${name} PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include)
+    target_link_libraries(hairvox_${name} PUBLIC ${ARG_PUBLIC_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
+    hairvox_target_defaults(hairvox_${name})
+endfunction()

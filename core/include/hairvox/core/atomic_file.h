@@ -1,0 +1,21 @@
+// hairvox core: outputs are never half-written.
+//
+// Every output (.hair, .vdb, .exr, .png, caches, CSV) is written to a hidden
+// temporary file in the destination directory and renamed over the final name
+// only once complete and flushed to disk. If writing throws (bad data, Ctrl-C),
+// the temporary is removed and an existing file under the final name is left
+// untouched.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+
+namespace hairvox {
+
+/// Calls `write(tmpPath)` to produce the file, then atomically renames it to
+/// `finalPath`. Creates missing parent directories. Throws InputError naming
+/// `finalPath` when the destination cannot be written.
+void writeFileAtomically(const std::filesystem::path& finalPath,
+                         const std::function<void(const std::filesystem::path& tmpPath)>& write);
+
+} // namespace hairvox

@@ -1,0 +1,47 @@
+// hairvox core: progress reporting for long operations.
+//
+// Modelled on pbrt-v4's ProgressReporter: workers add completed work
+// atomically; one background thread redraws the bar on stderr with back-off.
+// Disabled (and costing one atomic add per call) when stderr is not a terminal
+// or the user asked for quiet output.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <mutex>
+#include <string>
+#include <thread>
+
+namespace hairvox {
+
+class ProgressReporter {
+public:
+    /// `enabled == false` draws nothing; the terminal check is done by the caller
+    /// through stderrIsTerminal().
+    ProgressReporter(std::string title, std::uint64_t totalWork, bool enabled);
+    ~ProgressReporter();
+    ProgressReporter(const ProgressReporter&) = delete;
+    ProgressReporter& operator=(const ProgressReporter&) = delete;
+
+    /// Thread-safe.
+    void update(std::uint64_t work = 1) { done_.fetch_add(work, std::memory_order_relaxed); }
+    /// Draws the final state and stops the redraw thread; idempotent.
+    void finish();
+
+private:
+    void draw(bool final) const;
+
+    std::string title_;
+    std::uint64_t total_;
+    std::atomic<std::uint64_t> done_{0};
+    bool enabled_;
+    bool finished_ = false;
+    std::mutex mutex_;
+    std::condition_variable wake_;
+    std::thread thread_;
+};
+
+bool stderrIsTerminal();
+
+} // namespace hairvox

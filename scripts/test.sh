@@ -1,0 +1,8 @@
+#!/usr/bin/env bash
+# README command 2: install, build (warnings are errors) and run every test
+# (ctest labels fast and slow). Exits non-zero on any failure.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/setup.sh
+bash scripts/build.sh release
+ctest --test-dir build/release --output-on-failure -j "${HAIRVOX_JOBS:-2}"

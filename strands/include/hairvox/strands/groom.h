@@ -1,0 +1,74 @@
+// hairvox strands: the in-memory groom every stage consumes.
+//
+// A groom is a set of strands; strand i is the polyline
+// points[strandStart[i]] .. points[strandStart[i+1] - 1], ordered root → tip
+// (the fiber tangent u of DESIGN.md §2 points along increasing index).
+// Optional per-point attributes are either empty or exactly one value per point.
+// Units are the file's (metres for TressFX and the procedural grooms).
+#pragma once
+
+#include <hairvox/core/rgb.h>
+#include <hairvox/core/vecmath.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <ostream>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace hairvox {
+
+struct Groom {
+    std::vector<Vec3f> points;
+    /// strandStart.size() == strandCount() + 1; strandStart.front() == 0 and
+    /// strandStart.back() == points.size(). Empty for an empty groom.
+    std::vector<std::uint32_t> strandStart;
+    std::vector<float> thickness;    ///< per point, optional (file semantics, not used for rendering)
+    std::vector<float> transparency; ///< per point, optional
+    std::vector<Rgb> color;          ///< per point, optional
+
+    std::size_t strandCount() const { return strandStart.empty() ? 0 : strandStart.size() - 1; }
+    std::size_t pointCount() const { return points.size(); }
+    std::size_t segmentCount() const { return points.size() - strandCount(); }
+    bool empty() const { return strandCount() == 0; }
+
+    std::span<const Vec3f> strand(std::size_t i) const {
+        return {points.data() + strandStart[i], strandStart[i + 1] - strandStart[i]};
+    }
+
+    /// Appends one strand's points. Grooms built this way carry no optional
+    /// attributes (readers of files that have them fill the arrays directly).
+    void addStrand(std::span<const Vec3f> strandPoints);
+
+    Bounds3f bounds() const;
+    /// Σ over segments of |p_{k+1} − p_k|, accumulated in double.
+    double totalLength() const;
+};
+
+/// Summary figures printed by `hairvox info` and recorded as grid metadata.
+struct GroomStats {
+    std::size_t strands = 0, points = 0, segments = 0;
+    Bounds3f bounds;
+    double totalLength = 0, meanSegmentLength = 0;
+    double minSegmentLength = 0, maxSegmentLength = 0;
+};
+
+GroomStats computeStats(const Groom& groom);
+
+std::ostream& operator<<(std::ostream& os, const Groom& groom);
+
+/// What sanitizeGroom() removed: reported to the user as warnings, not errors.
+struct SanitizeReport {
+    std::size_t droppedSegments = 0; ///< zero-length segments (a point repeating its predecessor)
+    std::size_t droppedStrands = 0;  ///< strands left with a single point after that
+};
+
+/// Checks a freshly read groom and makes it valid for every later stage.
+/// Throws InputError naming `source`, the strand and the point for non-finite
+/// coordinates and for strands with fewer than 2 points; drops zero-length
+/// segments (and strands that collapse to one point) and reports the counts.
+/// Also checks that optional attribute arrays have one value per point.
+SanitizeReport sanitizeGroom(Groom& groom, const std::string& source);
+
+} // namespace hairvox

@@ -1,0 +1,54 @@
+#include "test_util.h"
+
+#include <gtest/gtest.h>
+
+namespace hairvox {
+namespace {
+
+TEST(Cli, GenerateThenInfo) {
+    test::TempDir dir;
+    const auto out = dir / "w.hair";
+    auto r = test::runHairvox("generate wavy --strands 100 --seed 3 -o '" + out.string() + "'");
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    r = test::runHairvox("info '" + out.string() + "'");
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("strands:             100"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("total fiber length"), std::string::npos) << r.output;
+}
+
+TEST(Cli, InfoOnRatboy) {
+    const auto r = test::runHairvox("info --json '" +
+                                    (test::dataDir() / "Ratboy_mohawk.tfx").string() + "'");
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("\"strands\": 2228"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("\"points\": 71296"), std::string::npos) << r.output;
+}
+
+TEST(Cli, HelpOnEverySubcommand) {
+    for (const char* sub : {"", "generate", "info"}) {
+        const auto r = test::runHairvox(std::string(sub) + " --help");
+        EXPECT_EQ(r.exitCode, 0) << sub << ": " << r.output;
+        EXPECT_NE(r.output.find("Usage"), std::string::npos) << sub;
+    }
+}
+
+TEST(Cli, BadUsageAndBadInputExitWith2) {
+    test::TempDir dir;
+    EXPECT_EQ(test::runHairvox("").exitCode, 2);
+    EXPECT_EQ(test::runHairvox("frobnicate").exitCode, 2);
+    EXPECT_EQ(test::runHairvox("generate spiky -o x.hair").exitCode, 2);
+    EXPECT_EQ(test::runHairvox("generate wavy --strands 0 -o x.hair").exitCode, 2);
+    test::writeText(dir / "bad.hair", "HAIR but not really");
+    const auto r = test::runHairvox("info '" + (dir / "bad.hair").string() + "'");
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.output.find("bad.hair"), std::string::npos) << r.output;
+    EXPECT_EQ(test::runHairvox("info '" + (dir / "missing.tfx").string() + "'").exitCode, 2);
+}
+
+TEST(Cli, UnwritableOutputExitsWith2) {
+    const auto r = test::runHairvox("generate wavy --strands 10 -o /proc/hairvox/x.hair");
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+}
+
+} // namespace
+} // namespace hairvox

@@ -1,0 +1,108 @@
+#include <hairvox/core/error.h>
+#include <hairvox/strands/procedural.h>
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+namespace hairvox {
+namespace {
+
+ProceduralGroomParams paramsFor(GroomStyle style, std::uint32_t strands, std::uint64_t seed = 1) {
+    ProceduralGroomParams p;
+    p.style = style;
+    p.strands = strands;
+    p.seed = seed;
+    return p;
+}
+
+bool samePoints(const Groom& a, const Groom& b) {
+    return a.points.size() == b.points.size() &&
+           std::memcmp(a.points.data(), b.points.data(), a.points.size() * sizeof(Vec3f)) == 0;
+}
+
+class ProceduralStyles : public ::testing::TestWithParam<GroomStyle> {};
+
+TEST_P(ProceduralStyles, DeterministicBySeed) {
+    const Groom a = generateGroom(paramsFor(GetParam(), 500, 3));
+    const Groom b = generateGroom(paramsFor(GetParam(), 500, 3));
+    const Groom c = generateGroom(paramsFor(GetParam(), 500, 4));
+    EXPECT_TRUE(samePoints(a, b));
+    EXPECT_FALSE(samePoints(a, c));
+}
+
+TEST_P(ProceduralStyles, ShapedLikeHairOnAHead) {
+    const ProceduralGroomParams params = paramsFor(GetParam(), 2000);
+    const Groom g = generateGroom(params);
+    ASSERT_EQ(g.strandCount(), 2000u);
+    EXPECT_EQ(g.strand(0).size(), params.resolvedPointsPerStrand());
+    double meanLength = 0;
+    std::size_t below = 0;
+    for (std::size_t s = 0; s < g.strandCount(); ++s) {
+        const auto pts = g.strand(s);
+        // Roots on the scalp: on the sphere and above the nape hairline.
+        EXPECT_NEAR(glm::length(pts[0] - params.headCenter), params.headRadius,
+                    0.01f * params.headRadius);
+        EXPECT_GT(pts[0].y, -0.5f * params.headRadius);
+        for (const Vec3f& p : pts) {
+            ASSERT_TRUE(isFinite(p));
+            EXPECT_GE(glm::length(p - params.headCenter), 0.999f * params.headRadius);
+        }
+        double length = 0;
+        for (std::size_t k = 1; k < pts.size(); ++k)
+            length += double(glm::distance(pts[k - 1], pts[k]));
+        meanLength += length / double(g.strandCount());
+        // Gravity: tips end below their roots for nearly every strand.
+        below += pts.back().y < pts[0].y ? 1u : 0u;
+    }
+    EXPECT_NEAR(meanLength, params.length, 0.2 * double(params.length));
+    EXPECT_GT(below, g.strandCount() * 90u / 100u);
+}
+
+INSTANTIATE_TEST_SUITE_P(AllStyles, ProceduralStyles,
+                         ::testing::Values(GroomStyle::Straight, GroomStyle::Wavy,
+                                           GroomStyle::Curly),
+                         [](const auto& param) { return std::string(toString(param.param)); });
+
+TEST(Procedural, CurlyHairCurls) {
+    // Curly strands turn: the sum of turning angles far exceeds a straight strand's.
+    auto turning = [](const Groom& g) {
+        double total = 0;
+        for (std::size_t s = 0; s < g.strandCount(); ++s) {
+            const auto p = g.strand(s);
+            for (std::size_t k = 2; k < p.size(); ++k) {
+                const Vec3f a = glm::normalize(p[k - 1] - p[k - 2]);
+                const Vec3f b = glm::normalize(p[k] - p[k - 1]);
+                total += std::acos(std::clamp(double(glm::dot(a, b)), -1.0, 1.0));
+            }
+        }
+        return total / double(g.strandCount());
+    };
+    const double straight = turning(generateGroom(paramsFor(GroomStyle::Straight, 200)));
+    const double curly = turning(generateGroom(paramsFor(GroomStyle::Curly, 200)));
+    EXPECT_GT(curly, 5.0 * straight);
+    EXPECT_GT(curly, 6.0 * 2.0 * Pi); // at least six full turns per strand
+}
+
+TEST(Procedural, AnyStrandCount) {
+    EXPECT_EQ(generateGroom(paramsFor(GroomStyle::Wavy, 1)).strandCount(), 1u);
+    EXPECT_EQ(generateGroom(paramsFor(GroomStyle::Wavy, 7)).strandCount(), 7u);
+}
+
+TEST(Procedural, InvalidParametersNameTheRange) {
+    ProceduralGroomParams p;
+    p.strands = 0;
+    try {
+        generateGroom(p);
+        FAIL() << "expected InputError";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("strands"), std::string::npos);
+        EXPECT_NE(std::string(e.what()).find("range"), std::string::npos);
+    }
+    p = {};
+    p.pointsPerStrand = 1;
+    EXPECT_THROW(generateGroom(p), InputError);
+}
+
+} // namespace
+} // namespace hairvox
