@@ -1,4 +1,5 @@
 #include <hairvox/core/error.h>
+#include <hairvox/core/hash.h>
 #include <hairvox/strands/groom.h>
 
 #include <algorithm>
@@ -52,6 +53,13 @@ GroomStats computeStats(const Groom& groom) {
         st.maxSegmentLength = maxLen;
     }
     return st;
+}
+
+std::uint64_t contentHash(const Groom& groom) {
+    Hasher h;
+    h.values(std::span<const Vec3f>(groom.points));
+    h.values(std::span<const std::uint32_t>(groom.strandStart));
+    return h.digest();
 }
 
 std::ostream& operator<<(std::ostream& os, const Groom& groom) {

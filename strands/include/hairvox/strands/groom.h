@@ -56,6 +56,10 @@ struct GroomStats {
 
 GroomStats computeStats(const Groom& groom);
 
+/// Content hash of the strand geometry (points and strand offsets): identifies a
+/// groom for caches and provenance metadata (DESIGN.md §7).
+std::uint64_t contentHash(const Groom& groom);
+
 std::ostream& operator<<(std::ostream& os, const Groom& groom);
 
 /// What sanitizeGroom() removed: reported to the user as warnings, not errors.
