@@ -1,0 +1,25 @@
+// hairvox transmittance: how the dual-scattering global term is computed
+// (docs/DESIGN.md §5). Every consumer (renderer, probe, benchmark) switches
+// between the modes through this one setting.
+#pragma once
+
+#include <optional>
+#include <ostream>
+#include <string_view>
+
+namespace hairvox {
+
+enum class GlobalTermMode {
+    Exact,  ///< Embree ray casting against the real strands (the reference)
+    Grid,   ///< ray march through the fiber grid with each voxel's own orientation
+    Approx, ///< n from the grid, every crossed fiber sharing the shading point's orientation
+};
+
+const char* toString(GlobalTermMode mode);
+std::optional<GlobalTermMode> parseGlobalTermMode(std::string_view name);
+
+inline std::ostream& operator<<(std::ostream& os, GlobalTermMode mode) {
+    return os << toString(mode);
+}
+
+} // namespace hairvox
