@@ -108,11 +108,6 @@ std::vector<Vec3f> scalpDirections(std::uint32_t count, std::uint64_t seed) {
     return roots;
 }
 
-Vec3f normalizeOr(const Vec3f& v, const Vec3f& fallback) {
-    const float len = glm::length(v);
-    return len > 1e-12f ? v / len : fallback;
-}
-
 /// A standard normal variate (Box–Muller).
 float normalVariate(Pcg32& rng) {
     const float u1 = std::max(rng.uniformFloat(), 1e-7f), u2 = rng.uniformFloat();

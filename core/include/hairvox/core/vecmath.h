@@ -31,6 +31,12 @@ inline bool isFinite(const Vec3f& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 
+/// v / |v|, or `fallback` when v is too short to normalise reliably.
+inline Vec3f normalizeOr(const Vec3f& v, const Vec3f& fallback) {
+    const float len = glm::length(v);
+    return len > 1e-12f ? v / len : fallback;
+}
+
 /// Two unit vectors perpendicular to unit n and to each other (Duff et al. 2017,
 /// "Building an Orthonormal Basis, Revisited"): {s, t, n} is right-handed.
 inline void coordinateSystem(const Vec3f& n, Vec3f& s, Vec3f& t) {
@@ -64,5 +70,27 @@ inline std::ostream& operator<<(std::ostream& os, const Bounds3f& b) {
         return os << "Bounds3f(empty)";
     return os << "Bounds3f(" << b.min << " .. " << b.max << ")";
 }
+
+/// A sphere (the opaque head of a scene: it hides hair and blocks light).
+struct Sphere {
+    Vec3f center{0.0f};
+    float radius = 0;
+
+    bool contains(const Vec3f& p) const { return glm::dot(p - center, p - center) < radius * radius; }
+
+    /// Whether the segment o + t·d, t ∈ (0, tMax), meets the sphere; d unit.
+    bool intersects(const Vec3f& o, const Vec3f& d, float tMax) const {
+        const Vec3f oc = o - center;
+        const float b = glm::dot(oc, d);
+        const float c = glm::dot(oc, oc) - radius * radius;
+        if (c < 0)
+            return true; // starts inside
+        const float disc = b * b - c;
+        if (disc < 0 || b > 0)
+            return false; // misses, or points away
+        const float t0 = -b - std::sqrt(disc);
+        return t0 < tMax;
+    }
+};
 
 } // namespace hairvox
