@@ -1,0 +1,96 @@
+// hairvox transmittance: the one interface behind which the three modes of
+// the dual-scattering global term live (docs/DESIGN.md §5).
+//
+// A GlobalTermModel is built once per scene (Embree scene, fiber grid, tables);
+// forLight() prepares everything that depends on one light (for the grid mode
+// a cache volume of the global term) and returns a LightGlobalTerm that
+// evaluates batches of shading points. Every consumer — renderer, probe,
+// benchmark — switches modes only by building a different model.
+#pragma once
+
+#include <hairvox/core/vecmath.h>
+#include <hairvox/shading/fiber_params.h>
+#include <hairvox/shading/global_term.h>
+#include <hairvox/transmittance/crossing_table.h>
+#include <hairvox/transmittance/global_term_mode.h>
+#include <hairvox/transmittance/light_geometry.h>
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+
+namespace hairvox {
+
+inline constexpr std::uint32_t kUnknownStrand = UINT32_MAX;
+
+/// A point on a fiber and that fiber's unit tangent (root → tip). The strand
+/// index, when the caller knows it, saves the exact mode a search for the
+/// point's own fiber.
+struct GlobalTermQuery {
+    Vec3f position;
+    Vec3f tangent;
+    std::uint32_t strand = kUnknownStrand;
+};
+
+/// What a per-light evaluation skipped (DESIGN.md §7).
+struct GlobalTermStats {
+    std::uint64_t queries = 0;
+    std::uint64_t blockedByOccluder = 0; ///< shadowed by the opaque head: no march, no rays
+    std::uint64_t emptyPaths = 0;        ///< nothing in front: n = 0 without marching
+
+    GlobalTermStats& operator+=(const GlobalTermStats& o) {
+        queries += o.queries;
+        blockedByOccluder += o.blockedByOccluder;
+        emptyPaths += o.emptyPaths;
+        return *this;
+    }
+};
+
+/// The global term toward one light, ready to evaluate. Thread-safe.
+class LightGlobalTerm {
+public:
+    virtual ~LightGlobalTerm() = default;
+    /// out[i] is the global term at queries[i] (same size); deterministic for
+    /// any thread count and any batching.
+    virtual GlobalTermStats evaluate(std::span<const GlobalTermQuery> queries,
+                                     std::span<GlobalTerm> out) const = 0;
+    /// True when the light cannot reach the hair through anything: every
+    /// query evaluates to GlobalTerm::unoccluded() (or blocked by the head).
+    virtual bool seesNoHair() const { return false; }
+};
+
+/// Inputs every mode shares.
+struct GlobalTermSettings {
+    float fiberDiameter = 8e-5f;    ///< D, world units
+    float densityMultiplier = 1.0f; ///< one modeled strand stands for k real hairs
+    DualScatteringParams dualScattering;
+    std::optional<Sphere> occluder; ///< the opaque head: blocks light entirely
+
+    void validate() const;
+};
+
+class GlobalTermModel {
+public:
+    virtual ~GlobalTermModel() = default;
+    virtual GlobalTermMode mode() const = 0;
+    virtual std::unique_ptr<LightGlobalTerm> forLight(const LightGeometry& light) const = 0;
+};
+
+/// The global term from the expected optical depths along a shadow path under
+/// a Poisson model of fiber crossings (DESIGN.md §5), shared by the grid-based
+/// modes:
+///   n           expected number of crossings          → V = e^{−n}
+///   tauP        expected attenuation depth (per RGB)   → P = e^{−tauP}
+///   sumBeta2    expected Σβ̄_f² over crossings          → σ_f² = sumBeta2 / (1 − V)
+/// T_s = d_f·(P − V) ≥ 0, continuous as n → 0.
+GlobalTerm globalTermFromDepths(float n, const Rgb& tauP, const Rgb& sumBeta2, float d_f);
+
+/// Wraps a per-light evaluation so that points whose path to the light meets
+/// the settings' occluder get GlobalTerm::blocked() without being evaluated.
+/// Returns `inner` unchanged when there is no occluder.
+std::unique_ptr<LightGlobalTerm> withOccluder(std::unique_ptr<LightGlobalTerm> inner,
+                                              const std::optional<Sphere>& occluder,
+                                              const LightGeometry& light);
+
+} // namespace hairvox

@@ -1,0 +1,84 @@
+#include <hairvox/core/error.h>
+#include <hairvox/transmittance/global_term_model.h>
+
+#include <cmath>
+#include <vector>
+
+namespace hairvox {
+
+void GlobalTermSettings::validate() const {
+    if (!(fiberDiameter > 0 && fiberDiameter < 1e3f))
+        throw InputError(strCat("fiber diameter = ", fiberDiameter,
+                                " should be in the range (0, 1000)"));
+    if (!(densityMultiplier > 0 && densityMultiplier <= 1e6f))
+        throw InputError(strCat("density multiplier = ", densityMultiplier,
+                                " should be in the range (0, 1e6]"));
+    dualScattering.validate();
+    if (occluder && (!isFinite(occluder->center) || !(occluder->radius > 0)))
+        throw InputError("occluder sphere needs a finite centre and a radius > 0");
+}
+
+GlobalTerm globalTermFromDepths(float n, const Rgb& tauP, const Rgb& sumBeta2, float d_f) {
+    GlobalTerm g;
+    g.n = n;
+    g.V = std::exp(-n);
+    g.P = exp(-tauP);
+    g.T_s = d_f * max(g.P - Rgb(g.V), Rgb(0.0f));
+    // σ_f² conditioned on at least one crossing: E[Σβ̄²] / P(m ≥ 1). As n → 0,
+    // 1 − e^{−n} → n and the ratio tends to the mean β̄² of the fibers in front.
+    const float crossed = -std::expm1(-n);
+    g.sigma2_f = crossed > 0 ? sumBeta2 / crossed : Rgb(0.0f);
+    return g;
+}
+
+namespace {
+
+class OccludedLightGlobalTerm final : public LightGlobalTerm {
+public:
+    OccludedLightGlobalTerm(std::unique_ptr<LightGlobalTerm> inner, const Sphere& occluder,
+                            const LightGeometry& light)
+        : inner_(std::move(inner)), occluder_(occluder), light_(light) {}
+
+    GlobalTermStats evaluate(std::span<const GlobalTermQuery> queries,
+                             std::span<GlobalTerm> out) const override {
+        std::vector<GlobalTermQuery> open;
+        std::vector<std::size_t> openIndex;
+        open.reserve(queries.size());
+        openIndex.reserve(queries.size());
+        for (std::size_t i = 0; i < queries.size(); ++i) {
+            const LightGeometry::Path path = light_.pathFrom(queries[i].position);
+            if (occluder_.intersects(queries[i].position, path.omega, path.distance)) {
+                out[i] = GlobalTerm::blocked();
+            } else {
+                open.push_back(queries[i]);
+                openIndex.push_back(i);
+            }
+        }
+        std::vector<GlobalTerm> openOut(open.size());
+        GlobalTermStats stats = inner_->evaluate(open, openOut);
+        for (std::size_t k = 0; k < open.size(); ++k)
+            out[openIndex[k]] = openOut[k];
+        stats.queries = queries.size();
+        stats.blockedByOccluder += queries.size() - open.size();
+        return stats;
+    }
+
+    bool seesNoHair() const override { return inner_->seesNoHair(); }
+
+private:
+    std::unique_ptr<LightGlobalTerm> inner_;
+    Sphere occluder_;
+    LightGeometry light_;
+};
+
+} // namespace
+
+std::unique_ptr<LightGlobalTerm> withOccluder(std::unique_ptr<LightGlobalTerm> inner,
+                                              const std::optional<Sphere>& occluder,
+                                              const LightGeometry& light) {
+    if (!occluder)
+        return inner;
+    return std::make_unique<OccludedLightGlobalTerm>(std::move(inner), *occluder, light);
+}
+
+} // namespace hairvox
