@@ -1,9 +1,11 @@
+#include <hairvox/core/error.h>
 #include <hairvox/core/math.h>
 #include <hairvox/transmittance/crossing_table.h>
 
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <stdexcept>
 
 namespace hairvox {
 
@@ -25,9 +27,13 @@ CrossingTable CrossingTable::build(const std::function<Rgb(float theta)>& aBar_f
     for (int i = 0; i < samples; ++i) {
         const float theta = std::clamp(static_cast<float>(i) / table.scale_ - static_cast<float>(PiOver2),
                                        -static_cast<float>(PiOver2), static_cast<float>(PiOver2));
-        const Rgb a = clamp(aBar_f(theta), kMinABar, 1.0f);
+        const Rgb aRaw = aBar_f(theta), beta2 = beta2Bar_f(theta);
+        if (!aRaw.isFinite() || !beta2.isFinite())
+            throw std::invalid_argument(strCat("CrossingTable: non-finite a_f or beta2_f at theta = ",
+                                               theta, " (", aRaw, ", ", beta2, ")"));
+        const Rgb a = clamp(aRaw, kMinABar, 1.0f);
         Entry& e = table.entries_[static_cast<std::size_t>(i)];
-        e.values = {log(a), max(beta2Bar_f(theta), Rgb(0.0f))};
+        e.values = {log(a), max(beta2, Rgb(0.0f))};
         e.oneMinusABar_f = Rgb(1.0f) - a;
     }
     // Isotropic average ½∫_{−1}^{1} rates(s) ds = ½∫ rates(sin θ) cos θ dθ, by

@@ -48,6 +48,7 @@ public:
         Rates operator*(float w) const {
             return {cosTheta * w, wAbsorb * w, wLogA * w, wBeta2 * w};
         }
+        Rates operator+(const Rates& o) const { return Rates(*this) += o; }
     };
 
     /// Tabulates from functions of the inclination θ ∈ [−π/2, π/2] (radians),

@@ -1,0 +1,97 @@
+// hairvox transmittance: the global term from the fiber grid (docs/DESIGN.md §5).
+//
+// For one light, every active voxel v of the fiber grid gets the rates at which
+// a shadow ray accumulates the global term's optical depths (per unit length):
+//   n      λ_v·k·D·E_v[cos θ]                  expected fibers crossed → V = e^{−n}
+//   tauP   λ_v·k·D·E_v[cos θ·(1 − ā_f(θ))]     (Poisson estimate of E[P] = e^{−tauP})
+//      or  λ_v·k·D·E_v[cos θ·(−ln ā_f(θ))]     (the paper's geometric form ā_f^n)
+//   Σβ²    λ_v·k·D·E_v[cos θ·β̄_f²(θ)]          → σ_f² = Σβ² / (1 − V)
+// with sin θ = ω·u over the fibers u in the voxel (the orientation model says
+// how E_v is estimated from what voxelize stored). The rates are reconstructed
+// between voxels with the fiber grid's own trilinear convention, and a shadow
+// ray integrates them *exactly*: along a line the trilinear field is a cubic
+// polynomial within each cell, so Simpson's rule per cell crossing has no step
+// error. Empty space is skipped a brick (8³ voxels, an OpenVDB leaf) at a time,
+// and the march stops once nothing more can change the result (V and every
+// channel of P below 1e-7).
+//
+// Two ways to evaluate a light (both exact integrals of the same field):
+//  - march: each query integrates from its point to the light. Cost per query
+//    grows with the path length through hair, and a march is memory-bound
+//    (random access to the volume): fine for probes, slow for a frame.
+//  - cache (default): forLight() first computes the integral from every vertex
+//    of the volume to the light by a sweep — vertices are processed in slabs of
+//    decreasing distance to the light; each integrates exactly over a step of
+//    Δ voxels toward the light and adds the (trilinearly interpolated) cached
+//    value there, which an earlier slab computed. A query is then one trilinear
+//    lookup. The interpolation at each step blurs shadows by about a voxel over
+//    a long path; the error against exact mode is measured in the tests.
+//
+// Self-shadowing: the query point's own fiber is splatted into the voxels
+// around it; the integral starts `startOffset` voxels toward the light to leave
+// it out (the value is chosen by measurement against exact mode; see the
+// transmittance tests and README).
+//
+// The `approx` mode (RenderMan report §2.1) uses the same march for n only and
+// assumes every fiber in front shares the shading point's orientation θ_x:
+// P from n·(1 − ā_f(θ_x)) (or ā_f(θ_x)^n), Σβ² = n·β̄_f²(θ_x).
+#pragma once
+
+#include <hairvox/transmittance/global_term_model.h>
+
+#include <memory>
+#include <ostream>
+
+namespace hairvox {
+
+struct FiberGrid;
+
+/// How E_v[w(θ)] is estimated from a voxel's stored orientation statistics.
+enum class OrientationModel {
+    MeanTangent,    ///< w at the normalised mean tangent o/|o| (DESIGN.md's simplest estimate)
+    CoherenceBlend, ///< |o|·w(o/|o|) + (1 − |o|)·(isotropic average of w)
+    Tensor,         ///< w at |sin θ| = sqrt(ωᵀ E[uuᵀ] ω), symmetrised (needs the tensor grids)
+};
+
+/// The estimator of E[P] = E[∏ ā_f(θ_k)] under Poisson-distributed crossings.
+enum class AttenuationEstimator {
+    Poisson,   ///< exp(−∫ λkD E[cos θ (1 − ā_f)] ds): the mean of ∏ā_f over crossings
+    Geometric, ///< exp(∫ λkD E[cos θ ln ā_f] ds): the paper's ā_f^n (a geometric mean; biased low)
+};
+
+const char* toString(OrientationModel model);
+const char* toString(AttenuationEstimator estimator);
+
+/// How a LightGlobalTerm of the grid modes evaluates its queries.
+enum class GridEvaluation {
+    Cache, ///< per-light cache volume, one lookup per query
+    March, ///< one exact march per query
+};
+
+const char* toString(GridEvaluation evaluation);
+
+struct GridOptions {
+    OrientationModel orientation = OrientationModel::CoherenceBlend;
+    AttenuationEstimator estimator = AttenuationEstimator::Poisson;
+    GridEvaluation evaluation = GridEvaluation::Cache;
+    float startOffset = 0.0f; ///< voxels toward the light before integrating, [0, 8]
+    float cacheStep = 3.0f;   ///< Δ of the cache sweep, voxels, [2, 64]
+
+    void validate(const FiberGrid& grid) const;
+};
+
+std::ostream& operator<<(std::ostream& os, const GridOptions& options);
+
+/// The `grid` mode. The model keeps a reference to `grid`, which must outlive it
+/// and every LightGlobalTerm it returns.
+std::unique_ptr<GlobalTermModel> makeGridModel(const FiberGrid& grid, const CrossingTable& crossings,
+                                               const GlobalTermSettings& settings,
+                                               const GridOptions& options);
+
+/// The `approx` mode (same lifetime rule).
+std::unique_ptr<GlobalTermModel> makeApproxModel(const FiberGrid& grid,
+                                                 const CrossingTable& crossings,
+                                                 const GlobalTermSettings& settings,
+                                                 const GridOptions& options);
+
+} // namespace hairvox

@@ -1,0 +1,287 @@
+#include "brick_volume.h"
+
+#include <glm/common.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace hairvox::detail {
+
+namespace {
+
+constexpr float kInfinity = std::numeric_limits<float>::infinity();
+
+std::uint32_t hashBrick(const glm::ivec3& b) {
+    return static_cast<std::uint32_t>(b.x) * 73856093u ^ static_cast<std::uint32_t>(b.y) * 19349663u ^
+           static_cast<std::uint32_t>(b.z) * 83492791u;
+}
+
+int valueIndex(int x, int y, int z) {
+    return (x * BrickVolume::kSide + y) * BrickVolume::kSide + z;
+}
+
+/// Trilinear interpolation of the 8 cell corners c[dx·4 + dy·2 + dz] at fractions f.
+inline Lanes trilinear(const Lanes* const c[8], const Vec3f& f) {
+    const float wx[2] = {1.0f - f.x, f.x}, wy[2] = {1.0f - f.y, f.y}, wz[2] = {1.0f - f.z, f.z};
+    Lanes r;
+    for (int k = 0; k < 8; ++k) {
+        const float w = wx[k >> 2] * wy[(k >> 1) & 1] * wz[k & 1];
+        for (int lane = 0; lane < 8; ++lane)
+            r.v[lane] += w * c[k]->v[lane];
+    }
+    return r;
+}
+
+/// a += w·(f0 + 4 fm + f1), lane by lane.
+inline void addSimpson(Lanes& a, const Lanes& f0, const Lanes& fm, const Lanes& f1, float w) {
+    for (int lane = 0; lane < 8; ++lane)
+        a.v[lane] += w * (f0.v[lane] + 4.0f * fm.v[lane] + f1.v[lane]);
+}
+
+} // namespace
+
+BrickVolume::BrickVolume(double voxelSize)
+    : h_(voxelSize), invH_(static_cast<float>(1.0 / voxelSize)), slots_(64, -1) {}
+
+std::size_t BrickVolume::memoryBytes() const {
+    return values_.capacity() * sizeof(Lanes) + brickCoord_.capacity() * sizeof(glm::ivec3) +
+           slots_.capacity() * sizeof(std::int64_t);
+}
+
+std::int64_t BrickVolume::find(const glm::ivec3& b) const {
+    const std::size_t mask = slots_.size() - 1;
+    for (std::size_t i = hashBrick(b) & mask;; i = (i + 1) & mask) {
+        const std::int64_t slot = slots_[i];
+        if (slot < 0 || brickCoord_[static_cast<std::size_t>(slot)] == b)
+            return slot;
+    }
+}
+
+void BrickVolume::grow() {
+    std::vector<std::int64_t> slots(slots_.size() * 2, -1);
+    const std::size_t mask = slots.size() - 1;
+    for (std::size_t brick = 0; brick < brickCount_; ++brick) {
+        const glm::ivec3& b = brickCoord_[brick];
+        std::size_t i = hashBrick(b) & mask;
+        while (slots[i] >= 0)
+            i = (i + 1) & mask;
+        slots[i] = static_cast<std::int64_t>(brick);
+    }
+    slots_.swap(slots);
+}
+
+std::int64_t BrickVolume::insert(const glm::ivec3& b) {
+    if (const std::int64_t found = find(b); found >= 0)
+        return found;
+    if (2 * (brickCount_ + 1) > slots_.size())
+        grow();
+    const std::size_t mask = slots_.size() - 1;
+    std::size_t i = hashBrick(b) & mask;
+    while (slots_[i] >= 0)
+        i = (i + 1) & mask;
+    slots_[i] = static_cast<std::int64_t>(brickCount_);
+    brickCoord_.push_back(b);
+    values_.resize(values_.size() + kBrickValues);
+    if (brickCount_ == 0) {
+        brickMin_ = brickMax_ = b;
+    } else {
+        brickMin_ = glm::min(brickMin_, b);
+        brickMax_ = glm::max(brickMax_, b);
+    }
+    return static_cast<std::int64_t>(brickCount_++);
+}
+
+void BrickVolume::reserveBrick(const glm::ivec3& b, int lowFaces) {
+    for (int mask = 0; mask < 8; ++mask)
+        if ((mask & lowFaces) == mask)
+            insert(b - glm::ivec3((mask >> 2) & 1, (mask >> 1) & 1, mask & 1));
+}
+
+BrickVolume::BrickSet BrickVolume::brickSet(const glm::ivec3& b) const {
+    BrickSet set;
+    for (int mask = 0; mask < 8; ++mask)
+        set.brick[mask] = find(b - glm::ivec3((mask >> 2) & 1, (mask >> 1) & 1, mask & 1));
+    return set;
+}
+
+void BrickVolume::set(const BrickSet& bricks, const glm::ivec3& local, const OpticalDepths& value) {
+    // The voxel's own brick, and the aprons below for each axis where it is on the low face.
+    const int onLowFace = (local.x == 0 ? 4 : 0) | (local.y == 0 ? 2 : 0) | (local.z == 0 ? 1 : 0);
+    for (int mask = 0; mask < 8; ++mask) {
+        if ((mask & onLowFace) != mask || bricks.brick[mask] < 0)
+            continue;
+        const glm::ivec3 l = local + kBrick * glm::ivec3((mask >> 2) & 1, (mask >> 1) & 1, mask & 1);
+        values_[static_cast<std::size_t>(bricks.brick[mask]) * kBrickValues +
+                static_cast<std::size_t>(valueIndex(l.x, l.y, l.z))] = Lanes::from(value);
+    }
+}
+
+template <typename F>
+void BrickVolume::walkBricks(const Vec3f& O, const Vec3f& dir, float s0, float s1, F&& visit) const {
+    if (empty())
+        return;
+    const Vec3f lo = Vec3f(kBrick * brickMin_), hi = Vec3f(kBrick * (brickMax_ + 1));
+    for (int a = 0; a < 3; ++a) { // clip to the bricks' bounding box
+        if (dir[a] == 0.0f) {
+            if (O[a] < lo[a] || O[a] > hi[a])
+                return;
+            continue;
+        }
+        const float ta = (lo[a] - O[a]) / dir[a], tb = (hi[a] - O[a]) / dir[a];
+        s0 = std::max(s0, std::min(ta, tb));
+        s1 = std::min(s1, std::max(ta, tb));
+    }
+    if (!(s0 < s1))
+        return;
+    // Brick-level DDA (bricks are 8 index units wide).
+    const Vec3f p0 = O + s0 * dir;
+    glm::ivec3 b = glm::clamp(glm::ivec3(glm::floor(p0 / float(kBrick))), brickMin_, brickMax_);
+    glm::ivec3 step;
+    Vec3f sNext, sDelta;
+    for (int a = 0; a < 3; ++a) {
+        step[a] = dir[a] > 0 ? 1 : (dir[a] < 0 ? -1 : 0);
+        sDelta[a] = dir[a] != 0 ? float(kBrick) / std::abs(dir[a]) : kInfinity;
+        sNext[a] = dir[a] != 0
+                       ? (float(kBrick * (b[a] + (dir[a] > 0 ? 1 : 0))) - O[a]) / dir[a]
+                       : kInfinity;
+    }
+    float s = s0;
+    for (;;) {
+        const float sExit = std::min({sNext.x, sNext.y, sNext.z, s1});
+        if (const std::int64_t brick = find(b); brick >= 0 && sExit > s)
+            if (!visit(static_cast<std::size_t>(brick), b, s, sExit))
+                return;
+        if (sExit >= s1)
+            return;
+        s = sExit;
+        const int a = sNext.x <= sNext.y ? (sNext.x <= sNext.z ? 0 : 2) : (sNext.y <= sNext.z ? 1 : 2);
+        b[a] += step[a];
+        sNext[a] += sDelta[a];
+        if (b[a] < brickMin_[a] || b[a] > brickMax_[a])
+            return;
+    }
+}
+
+OpticalDepths BrickVolume::integrate(const Vec3f& origin, const Vec3f& dir, float tStart,
+                                     float tEnd, float opaqueDepth, bool& touched) const {
+    // Index space: p(s) = O + s·dir with s = t/h; the sum is scaled by h at the end.
+    const Vec3f O = origin * invH_;
+    const float opaqueSum = opaqueDepth * invH_;
+    Lanes sum;
+    touched = false;
+    walkBricks(O, dir, tStart * invH_, std::isinf(tEnd) ? kInfinity : tEnd * invH_,
+               [&](std::size_t brick, const glm::ivec3& b, float s, float sExit) {
+                   touched = true;
+                   integrateBrick(brick, b, O, dir, s, sExit, sum);
+                   return !(sum.v[0] > opaqueSum &&
+                            std::min({sum.v[1], sum.v[2], sum.v[3]}) > opaqueSum);
+               });
+    return sum.depths() * static_cast<float>(h_);
+}
+
+float BrickVolume::firstBrickEntry(const Vec3f& origin, const Vec3f& dir, float tStart,
+                                   float tEnd) const {
+    float entry = kInfinity;
+    walkBricks(origin * invH_, dir, tStart * invH_, std::isinf(tEnd) ? kInfinity : tEnd * invH_,
+               [&](std::size_t, const glm::ivec3&, float s, float) {
+                   entry = s * static_cast<float>(h_);
+                   return false;
+               });
+    return entry;
+}
+
+bool BrickVolume::contains(const Vec3f& position) const {
+    return find(glm::ivec3(glm::floor(position * invH_)) >> 3) >= 0;
+}
+
+BrickVolume BrickVolume::emptyCopy() const {
+    BrickVolume copy(h_);
+    copy.slots_ = slots_;
+    copy.brickCount_ = brickCount_;
+    copy.brickCoord_ = brickCoord_;
+    copy.values_.assign(values_.size(), Lanes{});
+    copy.brickMin_ = brickMin_;
+    copy.brickMax_ = brickMax_;
+    return copy;
+}
+
+void BrickVolume::setValue(std::size_t index, const glm::ivec3& l, const OpticalDepths& value) {
+    values_[index * kBrickValues + static_cast<std::size_t>(valueIndex(l.x, l.y, l.z))] =
+        Lanes::from(value);
+}
+
+OpticalDepths BrickVolume::sample(const Vec3f& position) const {
+    const Vec3f q = position * invH_;
+    const glm::ivec3 c(glm::floor(q));
+    const glm::ivec3 b = c >> 3; // floor division by the brick size (C++20: arithmetic shift)
+    const std::int64_t brick = find(b);
+    if (brick < 0)
+        return {};
+    const Lanes* v = &values_[static_cast<std::size_t>(brick) * kBrickValues];
+    const glm::ivec3 l = c - kBrick * b;
+    const Lanes* corner[8];
+    for (int k = 0; k < 8; ++k)
+        corner[k] = &v[valueIndex(l.x + (k >> 2), l.y + ((k >> 1) & 1), l.z + (k & 1))];
+    return trilinear(corner, q - Vec3f(c)).depths();
+}
+
+void BrickVolume::integrateBrick(std::size_t brick, const glm::ivec3& b, const Vec3f& O,
+                                const Vec3f& dir, float sa, float sb, Lanes& sum) const {
+    const Lanes* v = &values_[brick * kBrickValues];
+    const glm::ivec3 base = kBrick * b;
+    // The cell containing the start: on a cell face, the one the ray enters.
+    const Vec3f pa = O + sa * dir;
+    glm::ivec3 c;
+    glm::ivec3 step;
+    Vec3f sNext, sDelta;
+    for (int a = 0; a < 3; ++a) {
+        int ci = static_cast<int>(std::floor(pa[a]));
+        if (dir[a] < 0 && static_cast<float>(ci) == pa[a])
+            --ci;
+        c[a] = std::clamp(ci, base[a], base[a] + kBrick - 1);
+        step[a] = dir[a] > 0 ? 1 : (dir[a] < 0 ? -1 : 0);
+        sDelta[a] = dir[a] != 0 ? 1.0f / std::abs(dir[a]) : kInfinity;
+        sNext[a] = dir[a] != 0 ? (float(c[a] + (dir[a] > 0 ? 1 : 0)) - O[a]) / dir[a] : kInfinity;
+    }
+    // The field is continuous: a cell's exit value is the next cell's entry value.
+    float s = sa;
+    Lanes fEntry;
+    bool haveEntry = false;
+    for (;;) {
+        const float sEnd = std::min({sNext.x, sNext.y, sNext.z, sb});
+        if (sEnd > s) {
+            const glm::ivec3 l = c - base;
+            const Lanes* corner[8];
+            bool any = false;
+            for (int k = 0; k < 8; ++k) {
+                corner[k] = &v[valueIndex(l.x + (k >> 2), l.y + ((k >> 1) & 1), l.z + (k & 1))];
+                any = any || corner[k]->v[0] != 0.0f;
+            }
+            if (any) {
+                // Simpson's rule: exact for the cubic the trilinear field is along a line.
+                const Vec3f cf(c);
+                if (!haveEntry)
+                    fEntry = trilinear(corner, O + s * dir - cf);
+                const Lanes fExit = trilinear(corner, O + sEnd * dir - cf);
+                addSimpson(sum, fEntry, trilinear(corner, O + (0.5f * (s + sEnd)) * dir - cf),
+                           fExit, (sEnd - s) / 6.0f);
+                fEntry = fExit;
+                haveEntry = true;
+            } else {
+                fEntry = Lanes{};
+                haveEntry = true;
+            }
+        }
+        if (sEnd >= sb)
+            break;
+        s = sEnd;
+        const int a = sNext.x <= sNext.y ? (sNext.x <= sNext.z ? 0 : 2) : (sNext.y <= sNext.z ? 1 : 2);
+        c[a] += step[a];
+        sNext[a] += sDelta[a];
+        if (c[a] < base[a] || c[a] >= base[a] + kBrick)
+            break;
+    }
+}
+
+} // namespace hairvox::detail

@@ -1,0 +1,375 @@
+// The grid and approx modes: per-light rate volumes built from the fiber grid
+// and integrated along shadow rays (see grid_global_term.h).
+#include "brick_volume.h"
+
+#include <hairvox/core/error.h>
+#include <hairvox/core/interrupt.h>
+#include <hairvox/transmittance/grid_global_term.h>
+#include <hairvox/voxelize/fiber_grid.h>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace hairvox {
+
+using detail::OpticalDepths;
+using detail::BrickVolume;
+
+const char* toString(OrientationModel model) {
+    switch (model) {
+    case OrientationModel::MeanTangent: return "mean-tangent";
+    case OrientationModel::CoherenceBlend: return "coherence-blend";
+    case OrientationModel::Tensor: return "tensor";
+    }
+    return "unknown";
+}
+
+const char* toString(GridEvaluation evaluation) {
+    switch (evaluation) {
+    case GridEvaluation::Cache: return "cache";
+    case GridEvaluation::March: return "march";
+    }
+    return "unknown";
+}
+
+const char* toString(AttenuationEstimator estimator) {
+    switch (estimator) {
+    case AttenuationEstimator::Poisson: return "poisson";
+    case AttenuationEstimator::Geometric: return "geometric";
+    }
+    return "unknown";
+}
+
+void GridOptions::validate(const FiberGrid& grid) const {
+    if (!(startOffset >= 0 && startOffset <= 8))
+        throw InputError(strCat("grid start offset = ", startOffset,
+                                " voxels should be in the range [0, 8]"));
+    if (!(cacheStep >= 2 && cacheStep <= 64))
+        throw InputError(strCat("grid cache step = ", cacheStep,
+                                " voxels should be in the range [2, 64]"));
+    if (orientation == OrientationModel::Tensor && !grid.hasTensor())
+        throw InputError("the tensor orientation model needs a fiber grid with the orientation "
+                         "tensor (voxelize --orientation-tensor)");
+    if (!grid.density || !grid.orientation || !(grid.info.voxelSize > 0))
+        throw InputError("the fiber grid has no density/orientation grids or no voxel size");
+}
+
+std::ostream& operator<<(std::ostream& os, const GridOptions& options) {
+    return os << "GridOptions(orientation=" << toString(options.orientation)
+              << ", estimator=" << toString(options.estimator)
+              << ", evaluation=" << toString(options.evaluation)
+              << ", startOffset=" << options.startOffset << " voxels, cacheStep="
+              << options.cacheStep << " voxels)";
+}
+
+namespace {
+
+/// Beyond this optical depth in n and every channel of tauP, V and P are
+/// below 1e-7: the rest of the path cannot change the global term.
+constexpr float kOpaqueDepth = 16.2f;
+
+/// What the per-voxel rates are made of: the fiber grid's statistics at one voxel.
+struct VoxelFibers {
+    float lambda;
+    Vec3f meanTangent;
+    Vec3f tensorDiag, tensorOffDiag;
+};
+
+/// E_v[rates(θ)] over the fibers of a voxel for light direction ω.
+CrossingTable::Rates expectedRates(const VoxelFibers& v, const Vec3f& omega,
+                                   const CrossingTable& table, OrientationModel model) {
+    const float coherence = std::min(glm::length(v.meanTangent), 1.0f);
+    if (!std::isfinite(coherence)) // a foreign .vdb: no orientation to trust
+        return table.isotropicRates();
+    switch (model) {
+    case OrientationModel::MeanTangent:
+        if (coherence < 1e-6f)
+            return table.isotropicRates();
+        return table.rates(glm::dot(omega, v.meanTangent) / coherence);
+    case OrientationModel::CoherenceBlend: {
+        CrossingTable::Rates r = table.isotropicRates() * (1.0f - coherence);
+        if (coherence > 0)
+            r += table.rates(glm::dot(omega, v.meanTangent) / coherence) * coherence;
+        return r;
+    }
+    case OrientationModel::Tensor: {
+        // E[(ω·u)²] = ωᵀ T ω with T = [[xx xy xz] [xy yy yz] [xz yz zz]].
+        const Vec3f& d = v.tensorDiag;
+        const Vec3f& o = v.tensorOffDiag;
+        const float s2 = d.x * omega.x * omega.x + d.y * omega.y * omega.y +
+                         d.z * omega.z * omega.z +
+                         2.0f * (o.x * omega.x * omega.y + o.y * omega.x * omega.z +
+                                 o.z * omega.y * omega.z);
+        const float s = std::sqrt(std::clamp(s2, 0.0f, 1.0f));
+        // The tensor has no sign: average the two inclinations ±θ.
+        return (table.rates(s) + table.rates(-s)) * 0.5f;
+    }
+    }
+    return table.isotropicRates();
+}
+
+class GridModel final : public GlobalTermModel {
+public:
+    GridModel(GlobalTermMode mode, const FiberGrid& grid, const CrossingTable& crossings,
+              const GlobalTermSettings& settings, const GridOptions& options)
+        : mode_(mode), grid_(grid), crossings_(crossings), settings_(settings), options_(options) {}
+
+    GlobalTermMode mode() const override { return mode_; }
+    std::unique_ptr<LightGlobalTerm> forLight(const LightGeometry& light) const override;
+
+    /// Per-light rates at every active voxel of the fiber grid.
+    BrickVolume buildRates(const LightGeometry& light) const;
+
+    const CrossingTable& crossings() const { return crossings_; }
+    const GlobalTermSettings& settings() const { return settings_; }
+    const GridOptions& options() const { return options_; }
+    double voxelSize() const { return grid_.info.voxelSize; }
+
+private:
+    GlobalTermMode mode_;
+    const FiberGrid& grid_;
+    CrossingTable crossings_;
+    GlobalTermSettings settings_;
+    GridOptions options_;
+};
+
+BrickVolume GridModel::buildRates(const LightGeometry& light) const {
+    using LeafT = openvdb::FloatTree::LeafNodeType;
+    const double h = grid_.info.voxelSize;
+    BrickVolume volume(h);
+    std::vector<const LeafT*> leaves;
+    grid_.density->tree().getNodes(leaves);
+    // The leaves' order is the tree's (deterministic); reserve serially, fill in parallel.
+    const auto brickOf = [](const LeafT& leaf) {
+        const openvdb::Coord o = leaf.origin();
+        return glm::ivec3(o.x(), o.y(), o.z()) / BrickVolume::kBrick; // origins are multiples of 8
+    };
+    for (const LeafT* leaf : leaves) {
+        int lowFaces = 0;
+        for (auto it = leaf->cbeginValueOn(); it; ++it) {
+            const openvdb::Coord l = it.getCoord() - leaf->origin();
+            lowFaces |= (l.x() == 0 ? 4 : 0) | (l.y() == 0 ? 2 : 0) | (l.z() == 0 ? 1 : 0);
+        }
+        volume.reserveBrick(brickOf(*leaf), lowFaces);
+    }
+    const float kD = settings_.densityMultiplier * settings_.fiberDiameter;
+    const bool tensor = options_.orientation == OrientationModel::Tensor;
+    const bool poisson = options_.estimator == AttenuationEstimator::Poisson;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size(), 4), [&](const auto& range) {
+        auto orientation = grid_.orientation->getConstAccessor();
+        auto diag = tensor ? grid_.tensorDiag->getConstAccessor() : orientation;
+        auto offDiag = tensor ? grid_.tensorOffDiag->getConstAccessor() : orientation;
+        for (std::size_t li = range.begin(); li != range.end(); ++li) {
+            const LeafT& leaf = *leaves[li];
+            const BrickVolume::BrickSet bricks = volume.brickSet(brickOf(leaf));
+            for (auto it = leaf.cbeginValueOn(); it; ++it) {
+                const openvdb::Coord c = it.getCoord();
+                const auto toVec = [](const openvdb::Vec3s& v) { return Vec3f(v.x(), v.y(), v.z()); };
+                VoxelFibers fibers{*it, toVec(orientation.getValue(c)), Vec3f(0.0f), Vec3f(0.0f)};
+                if (tensor) {
+                    fibers.tensorDiag = toVec(diag.getValue(c));
+                    fibers.tensorOffDiag = toVec(offDiag.getValue(c));
+                }
+                const Vec3f world = Vec3f(float(c.x()), float(c.y()), float(c.z())) * float(h);
+                const Vec3f omega = light.pathFrom(world).omega;
+                const CrossingTable::Rates r =
+                    expectedRates(fibers, omega, crossings_, options_.orientation);
+                const float scale = fibers.lambda * kD;
+                const openvdb::Coord l = c - leaf.origin();
+                volume.set(bricks, {l.x(), l.y(), l.z()},
+                           {scale * r.cosTheta, (poisson ? r.wAbsorb : r.wLogA) * scale,
+                            r.wBeta2 * scale});
+            }
+        }
+    });
+    return volume;
+}
+
+/// The cache volume: at every vertex of `rates`, the integral to the light
+/// (see grid_global_term.h for the sweep). Each brick's 8³ own vertices are
+/// computed once and copied into the aprons of the bricks below; apron
+/// vertices whose owning brick does not exist are computed where they are.
+BrickVolume buildCache(const BrickVolume& rates, const LightGeometry& light, float stepVoxels) {
+    BrickVolume cache = rates.emptyCopy();
+    const auto h = static_cast<float>(rates.voxelSize());
+    const float delta = stepVoxels * h;
+    // A vertex reads the cache at ≥ Δ toward the light, whose trilinear corners
+    // are at most √3·h farther from it: slabs this thin only read earlier slabs.
+    const float slab = delta - 1.75f * h;
+    constexpr int kBrick = BrickVolume::kBrick;
+
+    struct Vertex {
+        float key;          ///< larger is nearer the light
+        std::uint32_t brick;
+        std::uint8_t x, y, z; ///< local coordinates, [0, 9)
+        bool owned;         ///< an own vertex (< 8 on every axis), copied to the aprons below
+    };
+    std::vector<BrickVolume::BrickSet> brickSets(cache.brickCount());
+    std::vector<Vertex> vertices;
+    vertices.reserve(cache.brickCount() * kBrick * kBrick * kBrick);
+    float keyMax = -std::numeric_limits<float>::infinity();
+    for (std::size_t b = 0; b < cache.brickCount(); ++b) {
+        brickSets[b] = cache.brickSet(cache.brickCoord(b));
+        for (int x = 0; x <= kBrick; ++x)
+            for (int y = 0; y <= kBrick; ++y)
+                for (int z = 0; z <= kBrick; ++z) {
+                    const glm::ivec3 l(x, y, z);
+                    const bool owned = x < kBrick && y < kBrick && z < kBrick;
+                    if (!owned && cache.contains(cache.position(b, l) + 0.5f * h))
+                        continue; // another brick owns it and fills this apron
+                    const Vec3f p = cache.position(b, l);
+                    const float key = light.kind == LightGeometry::Kind::Directional
+                                          ? glm::dot(p, light.direction)
+                                          : -glm::distance(p, light.position);
+                    keyMax = std::max(keyMax, key);
+                    vertices.push_back({key, static_cast<std::uint32_t>(b),
+                                        static_cast<std::uint8_t>(x), static_cast<std::uint8_t>(y),
+                                        static_cast<std::uint8_t>(z), owned});
+                }
+    }
+    // Counting sort into slabs (stable: the order within a slab is deterministic).
+    const auto slabOf = [&](const Vertex& v) {
+        return static_cast<std::size_t>((keyMax - v.key) / slab);
+    };
+    std::size_t slabs = 0;
+    for (const Vertex& v : vertices)
+        slabs = std::max(slabs, slabOf(v) + 1);
+    std::vector<std::size_t> slabStart(slabs + 1, 0);
+    for (const Vertex& v : vertices)
+        ++slabStart[slabOf(v) + 1];
+    for (std::size_t k = 0; k < slabs; ++k)
+        slabStart[k + 1] += slabStart[k];
+    {
+        std::vector<Vertex> sorted(vertices.size());
+        std::vector<std::size_t> next(slabStart.begin(), slabStart.end() - 1);
+        for (const Vertex& v : vertices)
+            sorted[next[slabOf(v)]++] = v;
+        vertices.swap(sorted);
+    }
+
+    const float epsilon = 1e-3f * h; // past a brick face, into the brick
+    for (std::size_t k = 0; k < slabs; ++k) {
+        throwIfInterrupted();
+        tbb::parallel_for(
+            tbb::blocked_range<std::size_t>(slabStart[k], slabStart[k + 1], 256),
+            [&](const tbb::blocked_range<std::size_t>& range) {
+                for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                    const Vertex& v = vertices[i];
+                    const glm::ivec3 l(v.x, v.y, v.z);
+                    const Vec3f p = cache.position(v.brick, l);
+                    const LightGeometry::Path path = light.pathFrom(p);
+                    bool touched = false;
+                    OpticalDepths d = rates.integrate(p, path.omega, 0.0f,
+                                                      std::min(delta, path.distance),
+                                                      kOpaqueDepth, touched);
+                    if (delta < path.distance) {
+                        // Usually the step ends inside a brick; otherwise the
+                        // path crosses empty space to the next brick (or none).
+                        const Vec3f q = p + delta * path.omega;
+                        const float t = cache.contains(q) ? delta
+                                                          : cache.firstBrickEntry(p, path.omega,
+                                                                                  delta, path.distance);
+                        if (std::isfinite(t))
+                            d += cache.sample(p + (t + epsilon) * path.omega);
+                    }
+                    if (v.owned)
+                        cache.set(brickSets[v.brick], l, d);
+                    else
+                        cache.setValue(v.brick, l, d);
+                }
+            });
+    }
+    return cache;
+}
+
+class GridLightGlobalTerm final : public LightGlobalTerm {
+public:
+    GridLightGlobalTerm(const GridModel& model, const LightGeometry& light)
+        : model_(model), light_(light), rates_(model.buildRates(light)) {
+        if (model.options().evaluation == GridEvaluation::Cache)
+            cache_ = std::make_unique<BrickVolume>(
+                buildCache(rates_, light, model.options().cacheStep));
+    }
+
+    GlobalTermStats evaluate(std::span<const GlobalTermQuery> queries,
+                             std::span<GlobalTerm> out) const override {
+        std::vector<unsigned char> empty(queries.size(), 0);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, queries.size(), 64),
+                          [&](const tbb::blocked_range<std::size_t>& range) {
+                              for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                                  bool touched = false;
+                                  out[i] = evaluateOne(queries[i], touched);
+                                  empty[i] = touched ? 0 : 1;
+                              }
+                          });
+        GlobalTermStats stats;
+        stats.queries = queries.size();
+        for (unsigned char e : empty)
+            stats.emptyPaths += e;
+        return stats;
+    }
+
+private:
+    GlobalTerm evaluateOne(const GlobalTermQuery& q, bool& touched) const {
+        const LightGeometry::Path path = light_.pathFrom(q.position);
+        const float start = model_.options().startOffset * static_cast<float>(model_.voxelSize());
+        if (!(path.distance > start))
+            return GlobalTerm::unoccluded();
+        OpticalDepths d;
+        const Vec3f first = q.position + start * path.omega;
+        if (cache_ && cache_->contains(first)) {
+            d = cache_->sample(first);
+            touched = d.n > 0;
+        } else {
+            d = rates_.integrate(q.position, path.omega, start, path.distance, kOpaqueDepth,
+                                 touched);
+        }
+        const float d_f = model_.settings().dualScattering.d_f;
+        if (model_.mode() == GlobalTermMode::Grid)
+            return globalTermFromDepths(d.n, d.tauP, d.sumBeta2, d_f);
+        // approx: every fiber in front shares the shading point's orientation.
+        const float s = glm::dot(path.omega, q.tangent);
+        const CrossingTable::Values x = model_.crossings().crossing(s);
+        const Rgb perCrossing = model_.options().estimator == AttenuationEstimator::Poisson
+                                    ? Rgb(1.0f) - exp(x.logABar_f)
+                                    : -x.logABar_f;
+        return globalTermFromDepths(d.n, d.n * perCrossing, d.n * x.beta2Bar_f, d_f);
+    }
+
+    const GridModel& model_;
+    LightGeometry light_;
+    BrickVolume rates_;
+    std::unique_ptr<BrickVolume> cache_; ///< null when evaluating by march
+};
+
+std::unique_ptr<LightGlobalTerm> GridModel::forLight(const LightGeometry& light) const {
+    throwIfInterrupted();
+    return withOccluder(std::make_unique<GridLightGlobalTerm>(*this, light), settings_.occluder,
+                        light);
+}
+
+} // namespace
+
+std::unique_ptr<GlobalTermModel> makeGridModel(const FiberGrid& grid, const CrossingTable& crossings,
+                                               const GlobalTermSettings& settings,
+                                               const GridOptions& options) {
+    settings.validate();
+    options.validate(grid);
+    return std::make_unique<GridModel>(GlobalTermMode::Grid, grid, crossings, settings, options);
+}
+
+std::unique_ptr<GlobalTermModel> makeApproxModel(const FiberGrid& grid,
+                                                 const CrossingTable& crossings,
+                                                 const GlobalTermSettings& settings,
+                                                 const GridOptions& options) {
+    settings.validate();
+    options.validate(grid);
+    return std::make_unique<GridModel>(GlobalTermMode::Approx, grid, crossings, settings, options);
+}
+
+} // namespace hairvox
