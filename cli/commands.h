@@ -7,5 +7,6 @@ namespace hairvox::cli {
 
 void addGenerateCommand(CLI::App& app);
 void addInfoCommand(CLI::App& app);
+void addTablesCommand(CLI::App& app);
 
 } // namespace hairvox::cli
