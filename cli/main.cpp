@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
     hairvox::cli::addGenerateCommand(app);
     hairvox::cli::addInfoCommand(app);
     hairvox::cli::addTablesCommand(app);
+    hairvox::cli::addVoxelizeCommand(app);
     hairvox::installInterruptHandler();
 
     try {
