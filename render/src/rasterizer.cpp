@@ -284,7 +284,8 @@ void binSegments(RenderContext& ctx, RenderStats& stats) {
         for (std::size_t j = chunk * chunkSize; j < end; ++j) {
             const auto seg = static_cast<std::uint32_t>(j);
             const std::optional<ScreenRibbon> r = ctx.ribbon(seg);
-            if (!r || r->xMax <= 0 || r->yMax <= 0 || r->xMin >= width || r->yMin >= height) {
+            if (!r || !r->finite() ||
+                !(r->xMax > 0 && r->yMax > 0 && r->xMin < width && r->yMin < height)) {
                 culls[j] = Cull::OutsideView;
                 continue;
             }

@@ -13,7 +13,8 @@
 // clipping: per pixel row the ribbon is clipped to the row's slab, then the
 // area left of each pixel column boundary is a one-sided clip, and a pixel's
 // coverage is the difference of two of those areas. Double precision keeps
-// the difference exact to ~1e-9 pixel² at any raster coordinate. A quad that
+// the difference exact to ~1e-9 pixel² at any raster coordinate; a ribbon
+// reaching far beyond the tile is clipped to it first. A quad that
 // is not convex (the projected tangents bend sharply) is covered as its two
 // triangles ABC and ACD.
 #pragma once
@@ -39,6 +40,13 @@ struct ScreenRibbon {
     float invZ0, invZ1;  ///< 1 / depth at the ends
     float t0, t1;        ///< the ends' parameters on the original segment
     double xMin, yMin, xMax, yMax; ///< raster bounds of the quad
+
+    /// Finite bounds and depths (a groom with absurd coordinates can overflow).
+    bool finite() const {
+        return std::isfinite(xMin) && std::isfinite(xMax) && std::isfinite(yMin) &&
+               std::isfinite(yMax) && std::isfinite(invZ0) && std::isfinite(invZ1) &&
+               invZ0 > 0 && invZ1 > 0;
+    }
 
     /// Where the pixel centre `c` falls along the ribbon: the parameter on the
     /// original segment (perspective-correct) and the depth there.
@@ -201,16 +209,35 @@ void rasterizeConvex(const Polygon& poly, int x0, int y0, int x1, int y1, Emit& 
     }
 }
 
+/// The polygon clipped to [x0, x1] × [y0, y1] (keeps coordinates small
+/// before they are converted to pixel indices).
+inline Polygon clipToBox(const Polygon& p, double x0, double y0, double x1, double y1) {
+    Polygon a, b;
+    clip<0, false>(p, x0, a);
+    clip<0, true>(a, x1, b);
+    clip<1, false>(b, y0, a);
+    clip<1, true>(a, y1, b);
+    return b;
+}
+
 template <typename Emit, typename Wanted>
 void rasterizeRibbon(const ScreenRibbon& r, int x0, int y0, int x1, int y1, Emit&& emit,
                      Wanted&& wanted) {
     const Vec2d q[4] = {r.s0 + r.o0, r.s1 + r.o1, r.s1 - r.o1, r.s0 - r.o0};
+    const bool inside = r.xMin >= x0 - 1 && r.xMax <= x1 + 1 && r.yMin >= y0 - 1 && r.yMax <= y1 + 1;
+    auto cover = [&](const Polygon& p) {
+        if (inside)
+            rasterizeConvex(p, x0, y0, x1, y1, emit, wanted);
+        else
+            rasterizeConvex(clipToBox(p, x0 - 1, y0 - 1, x1 + 1, y1 + 1), x0, y0, x1, y1, emit,
+                            wanted);
+    };
     if (isConvexQuad(q)) {
         Polygon p;
         p.n = 4;
         for (int k = 0; k < 4; ++k)
             p.v[k] = q[k];
-        rasterizeConvex(p, x0, y0, x1, y1, emit, wanted);
+        cover(p);
         return;
     }
     for (const auto& [a, b, c] : {std::array<int, 3>{0, 1, 2}, std::array<int, 3>{0, 2, 3}}) {
@@ -219,7 +246,7 @@ void rasterizeRibbon(const ScreenRibbon& r, int x0, int y0, int x1, int y1, Emit
         t.v[0] = q[a];
         t.v[1] = q[b];
         t.v[2] = q[c];
-        rasterizeConvex(t, x0, y0, x1, y1, emit, wanted);
+        cover(t);
     }
 }
 
