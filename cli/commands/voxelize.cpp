@@ -1,0 +1,116 @@
+// hairvox voxelize HAIRFILE -o grid.vdb [--voxel-size V | --voxels-across N] [--diameter D]
+//                  [--density-scale K] [--orientation-tensor] [--threads N] [--memory-budget GIB]
+#include "../commands.h"
+#include "../report.h"
+
+#include <hairvox/core/error.h>
+#include <hairvox/core/parallel.h>
+#include <hairvox/core/progress.h>
+#include <hairvox/strands/groom_io.h>
+#include <hairvox/voxelize/fiber_grid.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+namespace hairvox::cli {
+
+namespace {
+
+struct VoxelizeOptions {
+    std::string input;
+    std::string output;
+    double voxelSize = 0;
+    int voxelsAcross = kDefaultVoxelsAcross;
+    float diameter = SplatOptions{}.fiberDiameter;
+    float densityScale = SplatOptions{}.densityScale;
+    bool tensor = false;
+    int threads = 0;
+    double memoryBudgetGiB = double(SplatOptions{}.memoryBudgetBytes) / double(1ull << 30);
+};
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void runVoxelize(const VoxelizeOptions& opt) {
+    const ThreadLimit threadLimit(opt.threads);
+    auto start = std::chrono::steady_clock::now();
+    const LoadedGroom loaded = readGroom(opt.input);
+    const double readSeconds = secondsSince(start);
+    for (const std::string& w : loaded.warnings)
+        std::fprintf(stderr, "hairvox: warning: %s: %s\n", opt.input.c_str(), w.c_str());
+
+    SplatOptions splat;
+    splat.voxelSize = opt.voxelSize > 0 ? opt.voxelSize
+                                        : defaultVoxelSize(loaded.groom, opt.voxelsAcross);
+    splat.fiberDiameter = opt.diameter;
+    splat.densityScale = opt.densityScale;
+    splat.storeOrientationTensor = opt.tensor;
+    splat.memoryBudgetBytes = static_cast<std::uint64_t>(opt.memoryBudgetGiB * double(1ull << 30));
+    splat.sourceFile = opt.input;
+    splat.showProgress = stderrIsTerminal();
+    start = std::chrono::steady_clock::now();
+    const FiberGrid grid = splatStrands(loaded.groom, splat);
+    const double splatSeconds = secondsSince(start);
+    for (const std::string& w : grid.warnings)
+        std::fprintf(stderr, "hairvox: warning: %s: %s\n", opt.input.c_str(), w.c_str());
+
+    start = std::chrono::steady_clock::now();
+    writeFiberGrid(opt.output, grid);
+    const double writeSeconds = secondsSince(start);
+
+    const Vec3f extent = loaded.groom.bounds().extent();
+    const double longest = double(std::max({extent.x, extent.y, extent.z}));
+    std::printf("wrote %s\n", opt.output.c_str());
+    std::printf("voxel size:     %.6g (%.0f voxels across the groom)\n", grid.info.voxelSize,
+                longest > 0 ? std::ceil(longest / grid.info.voxelSize) : 0.0);
+    std::printf("active voxels:  %s\n", thousands(grid.activeVoxelCount()).c_str());
+    std::printf("memory:         %.1f MiB (%s)\n", double(grid.memoryBytes()) / double(1 << 20),
+                grid.hasTensor() ? "density, orientation, orientation tensor"
+                                 : "density, orientation");
+    std::printf("fiber length:   %.6g in %s strands, %s segments\n", grid.info.totalLength,
+                thousands(grid.info.strands).c_str(), thousands(grid.info.segments).c_str());
+    std::printf("time:           read %.3f s, voxelize %.3f s (%d threads), write %.3f s\n",
+                readSeconds, splatSeconds, activeThreadCount(), writeSeconds);
+}
+
+} // namespace
+
+void addVoxelizeCommand(CLI::App& app) {
+    auto opt = std::make_shared<VoxelizeOptions>();
+    CLI::App* cmd =
+        app.add_subcommand("voxelize", "Splat a groom into an OpenVDB fiber grid (.vdb)");
+    cmd->add_option("file", opt->input, "Groom file (.hair, .tfx, .obj)")->required();
+    cmd->add_option("-o,--output", opt->output, "Output .vdb file")->required();
+    CLI::Option* size = cmd->add_option("--voxel-size", opt->voxelSize,
+                                        "Voxel size in the groom's units (default: from "
+                                        "--voxels-across)")
+                            ->check(CLI::PositiveNumber);
+    CLI::Option* across =
+        cmd->add_option("--voxels-across", opt->voxelsAcross,
+                        "Voxels across the longest side of the groom's bounding box")
+            ->capture_default_str()
+            ->check(CLI::Range(1, 1 << 20));
+    size->excludes(across);
+    cmd->add_option("--diameter", opt->diameter, "Fiber diameter D, recorded in the grid")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--density-scale", opt->densityScale,
+                    "Real hairs per modeled strand, recorded in the grid")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    cmd->add_flag("--orientation-tensor", opt->tensor,
+                  "Also store the second moment E[u u^T] of the fiber directions");
+    cmd->add_option("--threads", opt->threads, "Threads (0: all cores)")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 1024));
+    cmd->add_option("--memory-budget", opt->memoryBudgetGiB,
+                    "Refuse voxel sizes estimated to need more memory than this (GiB)")
+        ->capture_default_str()
+        ->check(CLI::Range(0.001, 1e6));
+    cmd->callback([opt] { runVoxelize(*opt); });
+}
+
+} // namespace hairvox::cli

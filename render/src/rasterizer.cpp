@@ -1,0 +1,930 @@
+#include "ribbon.h"
+
+#include <hairvox/core/error.h>
+#include <hairvox/core/interrupt.h>
+#include <hairvox/core/math.h>
+#include <hairvox/core/parallel.h>
+#include <hairvox/core/progress.h>
+#include <hairvox/render/render.h>
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+namespace hairvox {
+
+namespace {
+
+using raster::ScreenRibbon;
+using raster::Vec2d;
+using Clock = std::chrono::steady_clock;
+
+constexpr int kTileSize = 32;
+constexpr std::uint32_t kHeadFragment = std::numeric_limits<std::uint32_t>::max();
+constexpr std::size_t kShadeBatch = 1024;
+constexpr std::size_t kMaxWarnings = 10;
+/// Segments per binning chunk: at least this many, and at most 256 chunks.
+constexpr std::size_t kMinBinChunk = 8192;
+constexpr int kHeadSamples = 8; ///< per side, on the head's silhouette
+
+double secondsSince(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// --- geometry shared by all tiles ------------------------------------------
+
+/// Unit tangent at every point (the bisector of the adjacent segments'
+/// directions; a strand's end points take their one segment's), and every
+/// point's projection.
+void prepareVertices(const Groom& groom, const Camera& camera, float radius,
+                     std::vector<Vec3f>& tangents, std::vector<raster::ProjectedVertex>& projected) {
+    tangents.resize(groom.pointCount());
+    projected.resize(groom.pointCount());
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, groom.strandCount(), 512),
+        [&](const tbb::blocked_range<std::size_t>& range) {
+            for (std::size_t s = range.begin(); s != range.end(); ++s) {
+                const std::size_t begin = groom.strandStart[s], end = groom.strandStart[s + 1];
+                Vec3f previous(0.0f);
+                for (std::size_t k = begin; k < end; ++k) {
+                    const Vec3f next =
+                        k + 1 < end ? normalizeOr(groom.points[k + 1] - groom.points[k], Vec3f(0.0f))
+                                    : Vec3f(0.0f);
+                    tangents[k] = normalizeOr(previous + next, normalizeOr(next, previous));
+                    previous = next;
+                }
+                const std::span<const Vec3f> points(groom.points.data() + begin, end - begin);
+                raster::projectStrand(camera, points, {tangents.data() + begin, end - begin}, radius,
+                                      camera.nearClip(), {projected.data() + begin, end - begin});
+            }
+        });
+}
+
+/// The head seen from the camera: which pixels it covers, its depth and its
+/// Lambertian radiance.
+class HeadView {
+public:
+    HeadView(const Head& head, const Camera& camera, const std::vector<Light>& lights)
+        : head_(head), camera_(camera), lights_(lights) {
+        center_ = camera.directionToCamera(head.sphere.center - camera.position());
+        distance_ = glm::length(center_);
+        axis_ = center_ / distance_;
+        // A pixel spans at most 1/f radians, so pixel centres farther than that
+        // from the silhouette cone are wholly inside or outside it.
+        const float psi = safeASin(head.sphere.radius / distance_);
+        const float pixel = 1.0f / camera.focalLength();
+        cosInner_ = std::cos(std::max(psi - pixel, 0.0f));
+        cosOuter_ = std::cos(std::min(psi + pixel, float(Pi)));
+    }
+
+    /// Coverage, mean depth and mean radiance of the head in pixel (x, y).
+    bool cover(int x, int y, float& coverage, float& depth, Rgb& radiance) const {
+        const Vec2f centre(float(x) + 0.5f, float(y) + 0.5f);
+        const float cosPsi = glm::dot(camera_.rayDirection(centre), axis_);
+        if (cosPsi <= cosOuter_)
+            return false;
+        if (cosPsi >= cosInner_) {
+            coverage = 1.0f;
+            return sample(centre, depth, radiance);
+        }
+        int hits = 0;
+        double depthSum = 0;
+        Rgb radianceSum(0.0f);
+        for (int j = 0; j < kHeadSamples; ++j)
+            for (int i = 0; i < kHeadSamples; ++i) {
+                const Vec2f p(float(x) + (float(i) + 0.5f) / kHeadSamples,
+                              float(y) + (float(j) + 0.5f) / kHeadSamples);
+                float z;
+                Rgb l;
+                if (sample(p, z, l)) {
+                    ++hits;
+                    depthSum += double(z);
+                    radianceSum += l;
+                }
+            }
+        if (hits == 0)
+            return false;
+        coverage = float(hits) / float(kHeadSamples * kHeadSamples);
+        depth = static_cast<float>(depthSum / hits);
+        radiance = radianceSum / float(hits);
+        return true;
+    }
+
+private:
+    bool sample(const Vec2f& raster, float& depth, Rgb& radiance) const {
+        const Vec3f dir = camera_.rayDirection(raster);
+        const float b = glm::dot(dir, center_);
+        const float disc = b * b - (distance_ * distance_ - sqr(head_.sphere.radius));
+        const float t = b - std::sqrt(std::max(disc, 0.0f));
+        if (disc < 0 || !(t > 0))
+            return false; // missed, or the head is behind the camera
+        const Vec3f hitCam = t * dir;
+        depth = hitCam.z;
+        const Vec3f x = camera_.position() + camera_.toWorldDirection(hitCam);
+        const Vec3f normal = normalizeOr(x - head_.sphere.center, -camera_.toWorldDirection(dir));
+        Rgb irradiance(0.0f);
+        for (const Light& light : lights_) {
+            const Light::Path path = light.pathFrom(x);
+            const float cosTheta = glm::dot(normal, path.omega);
+            if (cosTheta > 0)
+                irradiance += cosTheta * light.irradiance(path.distance);
+        }
+        radiance = float(InvPi) * head_.albedo * irradiance;
+        return true;
+    }
+
+    const Head& head_;
+    const Camera& camera_;
+    const std::vector<Light>& lights_;
+    Vec3f center_, axis_;
+    float distance_, cosInner_, cosOuter_;
+};
+
+/// Hair wholly behind the head is culled before rasterization. A point is
+/// hidden if the camera ray to it enters a slightly smaller sphere before
+/// reaching it; the shrink keeps the ribbon's width and the head's
+/// anti-aliased silhouette pixels out of the test. The hidden region (sphere
+/// plus its shadow cone from the camera) is convex, so a segment whose two
+/// ends are hidden is hidden.
+class HeadOccluder {
+public:
+    HeadOccluder(const Head& head, const Camera& camera, float fiberRadius) {
+        center_ = camera.directionToCamera(head.sphere.center - camera.position());
+        const float d = glm::length(center_);
+        const float psi = safeASin(head.sphere.radius / d);
+        const float margin = 2.0f / camera.focalLength() +
+                             fiberRadius / std::max(d - head.sphere.radius, camera.nearClip());
+        enabled_ = psi > margin;
+        shrunkRadius_ = d * std::sin(psi - margin);
+        distance2_ = d * d;
+    }
+
+    bool hides(const Vec3f& pc) const {
+        if (!enabled_)
+            return false;
+        const float len = glm::length(pc);
+        if (!(len > 0))
+            return false;
+        const float b = glm::dot(pc, center_) / len;
+        const float disc = b * b - distance2_ + shrunkRadius_ * shrunkRadius_;
+        return disc > 0 && len > b - std::sqrt(disc);
+    }
+
+private:
+    Vec3f center_;
+    float distance2_ = 0, shrunkRadius_ = 0;
+    bool enabled_ = false;
+};
+
+/// Tiles a segment touches, or nothing (culled).
+struct TileRect {
+    std::uint16_t x0 = 0, y0 = 0, x1 = 0, y1 = 0; ///< [x0, x1) × [y0, y1); empty when culled
+    bool empty() const { return x0 >= x1 || y0 >= y1; }
+};
+
+enum class Cull : std::uint8_t { None, OutsideView, BehindHead };
+
+/// Whether the segment a → b passes within `r` of the box [lo, hi]: a
+/// conservative test (the box grown by r, slab method).
+bool segmentNearBox(const Vec2d& a, const Vec2d& b, Vec2d lo, Vec2d hi, double r) {
+    lo -= r;
+    hi += r;
+    double tMin = 0, tMax = 1;
+    for (int axis = 0; axis < 2; ++axis) {
+        const double d = b[axis] - a[axis];
+        if (std::abs(d) < 1e-12) {
+            if (a[axis] < lo[axis] || a[axis] > hi[axis])
+                return false;
+            continue;
+        }
+        double t0 = (lo[axis] - a[axis]) / d, t1 = (hi[axis] - a[axis]) / d;
+        if (t0 > t1)
+            std::swap(t0, t1);
+        tMin = std::max(tMin, t0);
+        tMax = std::min(tMax, t1);
+        if (tMin > tMax)
+            return false;
+    }
+    return true;
+}
+
+/// Everything the tiles share.
+struct RenderContext {
+    const Groom& groom;
+    const Scene& scene;
+    const FragmentShader& shader;
+    const RenderOptions& options;
+    Camera camera;
+    float fiberRadius;
+    std::vector<Vec3f> tangents;
+    std::vector<raster::ProjectedVertex> projected; ///< per point
+    std::vector<std::uint32_t> firstPoint; ///< per segment: the point index of its root-side vertex
+    int tilesX = 0, tilesY = 0;
+    std::vector<std::size_t> binStart; ///< per tile, into binSegments (+1 entry)
+    std::vector<std::uint32_t> binSegments;
+    std::optional<HeadView> head;
+    Film* film = nullptr;
+
+    RenderContext(const Groom& g, const Scene& s, const FragmentShader& sh, const RenderOptions& o)
+        : groom(g), scene(s), shader(sh), options(o), camera(s.camera),
+          fiberRadius(0.5f * s.fiberDiameter) {}
+
+    std::optional<ScreenRibbon> ribbon(std::uint32_t segment) const {
+        const std::uint32_t k = firstPoint[segment];
+        if (projected[k].valid() && projected[k + 1].valid())
+            return raster::ribbonBetween(projected[k], projected[k + 1]);
+        return raster::projectRibbon(camera, groom.points[k], groom.points[k + 1], tangents[k],
+                                     tangents[k + 1], fiberRadius, camera.nearClip());
+    }
+    std::uint32_t strandOfPoint(std::uint32_t point) const {
+        const auto it = std::upper_bound(groom.strandStart.begin(), groom.strandStart.end(), point);
+        return static_cast<std::uint32_t>(it - groom.strandStart.begin() - 1);
+    }
+};
+
+std::vector<std::uint32_t> segmentFirstPoints(const Groom& groom) {
+    std::vector<std::uint32_t> first;
+    first.reserve(groom.segmentCount());
+    for (std::size_t s = 0; s < groom.strandCount(); ++s)
+        for (std::uint32_t k = groom.strandStart[s]; k + 1 < groom.strandStart[s + 1]; ++k)
+            first.push_back(k);
+    return first;
+}
+
+/// Bins segments to the tiles their ribbon may touch. Chunks of segments are
+/// counted, then written, in chunk order: each tile's list is sorted by
+/// segment index whatever the thread count.
+void binSegments(RenderContext& ctx, RenderStats& stats) {
+    const std::size_t segments = ctx.firstPoint.size();
+    const std::size_t tiles = std::size_t(ctx.tilesX) * std::size_t(ctx.tilesY);
+    const std::size_t chunkSize = std::max(kMinBinChunk, (segments + 255) / 256);
+    const std::size_t chunks = (segments + chunkSize - 1) / chunkSize;
+    const int width = ctx.camera.width(), height = ctx.camera.height();
+    std::optional<HeadOccluder> occluder;
+    if (ctx.scene.head)
+        occluder.emplace(*ctx.scene.head, ctx.camera, ctx.fiberRadius);
+
+    std::vector<TileRect> rects(segments);
+    std::vector<Cull> culls(segments, Cull::None);
+    std::vector<std::size_t> counts(chunks * tiles, 0);
+    auto touches = [&](const ScreenRibbon& r, int tx, int ty) {
+        const Vec2d lo(tx * kTileSize, ty * kTileSize);
+        return segmentNearBox(r.s0, r.s1, lo, lo + double(kTileSize),
+                              std::max(glm::length(r.o0), glm::length(r.o1)));
+    };
+    tbb::parallel_for(std::size_t(0), chunks, [&](std::size_t chunk) {
+        throwIfInterrupted();
+        std::size_t* chunkCounts = counts.data() + chunk * tiles;
+        const std::size_t end = std::min(segments, (chunk + 1) * chunkSize);
+        for (std::size_t j = chunk * chunkSize; j < end; ++j) {
+            const auto seg = static_cast<std::uint32_t>(j);
+            const std::optional<ScreenRibbon> r = ctx.ribbon(seg);
+            if (!r || !r->finite() ||
+                !(r->xMax > 0 && r->yMax > 0 && r->xMin < width && r->yMin < height)) {
+                culls[j] = Cull::OutsideView;
+                continue;
+            }
+            if (occluder) {
+                const std::uint32_t k = ctx.firstPoint[j];
+                if (occluder->hides(ctx.camera.toCamera(ctx.groom.points[k])) &&
+                    occluder->hides(ctx.camera.toCamera(ctx.groom.points[k + 1]))) {
+                    culls[j] = Cull::BehindHead;
+                    continue;
+                }
+            }
+            TileRect& rect = rects[j];
+            rect.x0 = static_cast<std::uint16_t>(std::max(0.0, r->xMin) / kTileSize);
+            rect.y0 = static_cast<std::uint16_t>(std::max(0.0, r->yMin) / kTileSize);
+            rect.x1 = static_cast<std::uint16_t>(
+                std::min(double(ctx.tilesX), std::floor(r->xMax / kTileSize) + 1));
+            rect.y1 = static_cast<std::uint16_t>(
+                std::min(double(ctx.tilesY), std::floor(r->yMax / kTileSize) + 1));
+            for (int ty = rect.y0; ty < rect.y1; ++ty)
+                for (int tx = rect.x0; tx < rect.x1; ++tx)
+                    if (touches(*r, tx, ty))
+                        ++chunkCounts[std::size_t(ty) * std::size_t(ctx.tilesX) + std::size_t(tx)];
+        }
+    });
+
+    // Offsets in (tile, chunk) order.
+    ctx.binStart.assign(tiles + 1, 0);
+    std::vector<std::size_t> offsets(chunks * tiles);
+    std::size_t total = 0;
+    for (std::size_t t = 0; t < tiles; ++t) {
+        ctx.binStart[t] = total;
+        for (std::size_t c = 0; c < chunks; ++c) {
+            offsets[c * tiles + t] = total;
+            total += counts[c * tiles + t];
+        }
+    }
+    ctx.binStart[tiles] = total;
+    ctx.binSegments.resize(total);
+    tbb::parallel_for(std::size_t(0), chunks, [&](std::size_t chunk) {
+        std::size_t* chunkOffsets = offsets.data() + chunk * tiles;
+        const std::size_t end = std::min(segments, (chunk + 1) * chunkSize);
+        for (std::size_t j = chunk * chunkSize; j < end; ++j) {
+            const TileRect& rect = rects[j];
+            if (rect.empty())
+                continue;
+            const std::optional<ScreenRibbon> r = ctx.ribbon(static_cast<std::uint32_t>(j));
+            for (int ty = rect.y0; ty < rect.y1; ++ty)
+                for (int tx = rect.x0; tx < rect.x1; ++tx)
+                    if (touches(*r, tx, ty))
+                        ctx.binSegments[chunkOffsets[std::size_t(ty) * std::size_t(ctx.tilesX) +
+                                                     std::size_t(tx)]++] =
+                            static_cast<std::uint32_t>(j);
+        }
+    });
+
+    stats.segments = segments;
+    stats.segmentTileRefs = total;
+    for (Cull c : culls) {
+        stats.segmentsOutsideView += c == Cull::OutsideView ? 1u : 0u;
+        stats.segmentsBehindHead += c == Cull::BehindHead ? 1u : 0u;
+    }
+}
+
+// --- one tile ----------------------------------------------------------------
+
+constexpr std::uint32_t kNoPoint = std::numeric_limits<std::uint32_t>::max();
+constexpr GlobalTerm kZeroTerm{0.0f, 0.0f, Rgb(0.0f), Rgb(0.0f), Rgb(0.0f)};
+/// Segments rasterized between two compositing steps (see TileRenderer).
+constexpr std::size_t kSegmentsPerStep = 64;
+
+struct Fragment {
+    float depth;
+    float alpha;         ///< coverage, (0, 1]
+    float t;             ///< parameter on the segment, 0 at its root-side vertex
+    std::uint32_t local; ///< index in the tile's segment list, or kHeadFragment
+    std::uint32_t pixel; ///< index in the tile, row-major
+};
+
+/// A composited hair fragment: what shading needs.
+struct Visible {
+    std::uint32_t pixel;
+    std::uint32_t local;
+    float t;
+    float weight; ///< transmittance in front × coverage
+};
+
+/// Compositing state of one pixel, carried from one step to the next.
+struct PixelState {
+    float T = 1;             ///< transmittance of everything composited so far
+    float groupT = 1;        ///< T in front of the current strand group
+    float groupCoverage = 0; ///< coverage of the current strand group
+    std::uint32_t lastPoint = kNoPoint; ///< root-side point of the last composited hair fragment
+    bool closed = false;     ///< opaque: nothing behind is composited
+    float depthSum = 0, hairWeight = 0;
+    Rgb head{0.0f};
+};
+
+struct TileScratch {
+    std::vector<ScreenRibbon> ribbons;   ///< per local segment
+    std::vector<float> zMin;             ///< per local segment: its nearest depth
+    std::vector<std::uint32_t> order;    ///< local segments by (zMin, index)
+    std::vector<std::uint64_t> keys;     ///< sort keys of `order`
+    std::vector<std::uint32_t> strandOf; ///< per local segment
+    std::vector<std::uint32_t> pointOf;  ///< per local segment: its root-side point
+    std::vector<Fragment> pending, settling, sorted;
+    std::vector<std::uint32_t> pixelStart, cursor;
+    std::vector<PixelState> pixels;
+    std::vector<Rgb> headRadiance;
+    std::vector<Visible> visible;
+    std::vector<std::uint32_t> vertexSlot; ///< per local segment: slot of its root-side vertex
+    std::vector<std::uint32_t> slotPoint;  ///< per vertex slot: the point index
+    std::vector<std::uint32_t> slotStrand; ///< per vertex slot: its strand
+    std::vector<ShadeResult> vertexResults;
+    std::vector<GlobalTerm> vertexTerms, fragmentTerms;
+    std::vector<ShadingPoint> points;
+    std::vector<ShadeResult> results;
+    std::vector<GlobalTerm> terms;
+    std::vector<ShadeResult> pixelSum;  ///< per pixel: weighted radiance
+    std::vector<GlobalTerm> pixelTerms; ///< per pixel × light: weighted sums (σ_f in sigma2_f)
+};
+
+struct TileResult {
+    double rasterSeconds = 0, shadeSeconds = 0;
+    std::uint64_t fragments = 0, behindOpaque = 0, composited = 0, shadingPoints = 0, invalid = 0;
+    std::uint64_t segmentsSkipped = 0;
+    std::vector<std::string> warnings;
+};
+
+/// Finite and not negative (−0 included): one integer comparison on the bits.
+bool finiteNonNegative(float x) {
+    const auto bits = std::bit_cast<std::uint32_t>(x);
+    return bits < 0x7f800000u || bits == 0x80000000u;
+}
+
+bool isValid(const ShadeResult& r, std::span<const GlobalTerm> terms) {
+    bool ok = true;
+    for (const Rgb* c : {&r.directR, &r.directTT, &r.directTRT, &r.backDirect, &r.scatter})
+        ok &= finiteNonNegative(c->r) & finiteNonNegative(c->g) & finiteNonNegative(c->b);
+    for (const GlobalTerm& g : terms)
+        ok &= std::isfinite(g.n) & std::isfinite(g.V) & g.P.isFinite() & g.T_s.isFinite() &
+              g.sigma2_f.isFinite();
+    return ok;
+}
+
+ShadeResult lerp(float t, const ShadeResult& a, const ShadeResult& b) {
+    return {hairvox::lerp(t, a.directR, b.directR), hairvox::lerp(t, a.directTT, b.directTT),
+            hairvox::lerp(t, a.directTRT, b.directTRT),
+            hairvox::lerp(t, a.backDirect, b.backDirect), hairvox::lerp(t, a.scatter, b.scatter)};
+}
+
+GlobalTerm lerp(float t, const GlobalTerm& a, const GlobalTerm& b) {
+    return {hairvox::lerp(t, a.n, b.n), hairvox::lerp(t, a.V, b.V), hairvox::lerp(t, a.P, b.P),
+            hairvox::lerp(t, a.T_s, b.T_s), hairvox::lerp(t, a.sigma2_f, b.sigma2_f)};
+}
+
+/// Renders one tile.
+///
+/// Visibility without sorting everything: the tile's segments are taken in
+/// order of their nearest depth, kSegmentsPerStep at a time. After a step,
+/// every fragment nearer than the next segment's nearest depth Z is final (no
+/// later segment can put anything in front of it): those fragments are sorted
+/// per pixel by (depth, segment) and composited front to back, continuing each
+/// pixel's state. A pixel whose transmittance reaches the opaque threshold is
+/// closed, and later segments skip it before computing any coverage. The
+/// composited order is the full per-pixel depth order, so the result does not
+/// depend on the step size; it only decides how early hidden work is skipped.
+///
+/// Compositing: a fragment over the pixel, T ← T·(1 − α), weight T·α — except
+/// that a fragment of the segment adjacent to the previous composited fragment
+/// of the same strand (they tile one ribbon) adds its coverage to that
+/// strand's group: weight T_group·α, T ← T_group·(1 − Σα), Σα ≤ 1.
+class TileRenderer {
+public:
+    TileRenderer(const RenderContext& ctx, TileScratch& s, int tile)
+        : ctx_(ctx), s_(s), film_(*ctx.film), lights_(ctx.scene.lights.size()) {
+        const int tx = tile % ctx.tilesX, ty = tile / ctx.tilesX;
+        x0_ = tx * kTileSize;
+        y0_ = ty * kTileSize;
+        x1_ = std::min(ctx.camera.width(), x0_ + kTileSize);
+        y1_ = std::min(ctx.camera.height(), y0_ + kTileSize);
+        width_ = x1_ - x0_;
+        area_ = static_cast<std::uint32_t>(width_ * (y1_ - y0_));
+        bins_ = {ctx.binSegments.data() + ctx.binStart[std::size_t(tile)],
+                 ctx.binSegments.data() + ctx.binStart[std::size_t(tile) + 1]};
+    }
+
+    TileResult run() {
+        const Clock::time_point start = Clock::now();
+        prepare();
+        rasterizeAndComposite();
+        finishCoverage();
+        const Clock::time_point shadeStart = Clock::now();
+        if (ctx_.scene.shadingRate == ShadingRate::Fragment)
+            shadeFragments();
+        else
+            shadeVertices();
+        finishShading();
+        result_.shadeSeconds = secondsSince(shadeStart);
+        result_.rasterSeconds = secondsSince(start) - result_.shadeSeconds;
+        result_.fragments = result_.composited + result_.behindOpaque;
+        return std::move(result_);
+    }
+
+private:
+    std::size_t filmIndex(std::uint32_t pixel) const {
+        return film_.index(x0_ + int(pixel % std::uint32_t(width_)),
+                           y0_ + int(pixel / std::uint32_t(width_)));
+    }
+    std::uint32_t pixelIndex(int x, int y) const {
+        return static_cast<std::uint32_t>((y - y0_) * width_ + (x - x0_));
+    }
+
+    /// Projects the tile's segments, orders them by nearest depth, and puts
+    /// the head's fragments in the queue.
+    void prepare() {
+        const std::size_t n = bins_.size();
+        s_.ribbons.resize(n);
+        s_.zMin.resize(n);
+        s_.order.resize(n);
+        s_.strandOf.resize(n);
+        s_.pointOf.resize(n);
+        s_.keys.resize(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            s_.ribbons[i] = *ctx_.ribbon(bins_[i]);
+            s_.zMin[i] = 1.0f / std::max(s_.ribbons[i].invZ0, s_.ribbons[i].invZ1);
+            s_.pointOf[i] = ctx_.firstPoint[bins_[i]];
+            s_.strandOf[i] = ctx_.strandOfPoint(s_.pointOf[i]);
+            // (zMin, index) as one integer: positive floats order like their bits.
+            s_.keys[i] = (std::uint64_t(std::bit_cast<std::uint32_t>(s_.zMin[i])) << 32) | i;
+        }
+        std::sort(s_.keys.begin(), s_.keys.end());
+        for (std::size_t i = 0; i < n; ++i)
+            s_.order[i] = static_cast<std::uint32_t>(s_.keys[i]);
+        s_.pixels.assign(area_, PixelState{});
+        openPixels_ = area_;
+        s_.pending.clear();
+        s_.visible.clear();
+        if (!ctx_.head)
+            return;
+        s_.headRadiance.resize(area_);
+        for (int y = y0_; y < y1_; ++y)
+            for (int x = x0_; x < x1_; ++x) {
+                Fragment f{0, 0, 0, kHeadFragment, pixelIndex(x, y)};
+                if (ctx_.head->cover(x, y, f.alpha, f.depth, s_.headRadiance[f.pixel]))
+                    s_.pending.push_back(f);
+            }
+    }
+
+    void rasterizeAndComposite() {
+        const std::size_t n = s_.order.size();
+        auto open = [&](int x, int y) {
+            if (!s_.pixels[pixelIndex(x, y)].closed)
+                return true;
+            ++result_.behindOpaque;
+            return false;
+        };
+        for (std::size_t begin = 0; begin < n; begin += kSegmentsPerStep) {
+            if (openPixels_ == 0) {
+                result_.segmentsSkipped += n - begin;
+                break;
+            }
+            const std::size_t end = std::min(n, begin + kSegmentsPerStep);
+            for (std::size_t j = begin; j < end; ++j) {
+                const std::uint32_t local = s_.order[j];
+                const ScreenRibbon& r = s_.ribbons[local];
+                raster::rasterizeRibbon(
+                    r, x0_, y0_, x1_, y1_,
+                    [&](int x, int y, float coverage) {
+                        Fragment f;
+                        r.locate(Vec2d(x + 0.5, y + 0.5), f.t, f.depth);
+                        f.alpha = coverage;
+                        f.local = local;
+                        f.pixel = pixelIndex(x, y);
+                        s_.pending.push_back(f);
+                    },
+                    open);
+            }
+            settle(end < n ? s_.zMin[s_.order[end]] : std::numeric_limits<float>::infinity());
+        }
+        settle(std::numeric_limits<float>::infinity());
+    }
+
+    /// Composites, in depth order, every pending fragment nearer than z.
+    void settle(float z) {
+        s_.settling.clear();
+        std::size_t kept = 0;
+        for (const Fragment& f : s_.pending) {
+            if (f.depth < z)
+                s_.settling.push_back(f);
+            else
+                s_.pending[kept++] = f;
+        }
+        s_.pending.resize(kept);
+        if (s_.settling.empty())
+            return;
+        // Counting sort by pixel, then insertion sort per pixel by (depth,
+        // segment; the head after hair at equal depth): a total order.
+        s_.pixelStart.assign(area_ + 1, 0);
+        for (const Fragment& f : s_.settling)
+            ++s_.pixelStart[f.pixel + 1];
+        for (std::size_t p = 0; p < area_; ++p)
+            s_.pixelStart[p + 1] += s_.pixelStart[p];
+        s_.sorted.resize(s_.settling.size());
+        s_.cursor.assign(s_.pixelStart.begin(), s_.pixelStart.end() - 1);
+        for (const Fragment& f : s_.settling)
+            s_.sorted[s_.cursor[f.pixel]++] = f;
+        auto before = [](const Fragment& a, const Fragment& b) {
+            return a.depth < b.depth || (a.depth == b.depth && a.local < b.local);
+        };
+        for (std::size_t p = 0; p < area_; ++p) {
+            Fragment* first = s_.sorted.data() + s_.pixelStart[p];
+            Fragment* last = s_.sorted.data() + s_.pixelStart[p + 1];
+            if (first == last)
+                continue;
+            if (last - first > 32) {
+                std::sort(first, last, before);
+            } else {
+                for (Fragment* i = first + 1; i < last; ++i) {
+                    const Fragment f = *i;
+                    Fragment* j = i;
+                    for (; j > first && before(f, *(j - 1)); --j)
+                        *j = *(j - 1);
+                    *j = f;
+                }
+            }
+            PixelState& st = s_.pixels[p];
+            for (const Fragment* f = first; f != last; ++f)
+                composite(st, *f);
+        }
+    }
+
+    void composite(PixelState& st, const Fragment& f) {
+        const bool hair = f.local != kHeadFragment;
+        if (st.closed) {
+            result_.behindOpaque += hair ? 1u : 0u;
+            return;
+        }
+        const std::uint32_t point = hair ? s_.pointOf[f.local] : kNoPoint;
+        // Root-side points of one strand's segments are consecutive; across
+        // strands they differ by at least 2 (a strand's tip starts nothing).
+        if (hair && st.lastPoint != kNoPoint &&
+            (point > st.lastPoint ? point - st.lastPoint : st.lastPoint - point) <= 1) {
+            st.groupCoverage = std::min(st.groupCoverage + f.alpha, 1.0f);
+        } else {
+            st.groupT = st.T;
+            st.groupCoverage = f.alpha;
+        }
+        const float T = st.groupT * (hair ? hairTransmittance(st.groupCoverage)
+                                          : 1.0f - st.groupCoverage);
+        const float w = st.T - T; // this fragment's share: what it took from the transmittance
+        st.T = T;
+        st.lastPoint = point;
+        st.depthSum += w * f.depth;
+        if (hair) {
+            s_.visible.push_back({f.pixel, f.local, f.t, w});
+            st.hairWeight += w;
+            ++result_.composited;
+        } else {
+            st.head += w * s_.headRadiance[f.pixel];
+        }
+        if (st.T <= ctx_.options.opaqueTransmittance) {
+            st.closed = true;
+            --openPixels_;
+        }
+    }
+
+    /// Transmittance through a strand of coverage α standing for k hairs (the
+    /// density multiplier) at independent positions in the pixel: (1 − α)^k.
+    float hairTransmittance(float alpha) const {
+        const float k = ctx_.scene.densityMultiplier;
+        return k == 1.0f ? 1.0f - alpha : std::exp(k * std::log1p(-alpha));
+    }
+
+    void finishCoverage() {
+        for (std::uint32_t p = 0; p < area_; ++p) {
+            const PixelState& st = s_.pixels[p];
+            const std::size_t i = filmIndex(p);
+            film_.alpha[i] = 1.0f - st.T;
+            film_.hairAlpha[i] = st.hairWeight;
+            film_.depth[i] = st.T < 1.0f ? st.depthSum / (1.0f - st.T) : 0.0f;
+            film_.head[i] = st.head;
+            film_.background[i] = st.T * ctx_.scene.background;
+        }
+    }
+
+    ShadingPoint pointOnSegment(std::uint32_t local, float t) const {
+        const std::uint32_t k = s_.pointOf[local];
+        const Vec3f& p0 = ctx_.groom.points[k];
+        const Vec3f& p1 = ctx_.groom.points[k + 1];
+        ShadingPoint sp;
+        sp.position = hairvox::lerp(t, p0, p1);
+        sp.tangent = normalizeOr(hairvox::lerp(t, ctx_.tangents[k], ctx_.tangents[k + 1]),
+                                 normalizeOr(p1 - p0, Vec3f(0.0f, 1.0f, 0.0f)));
+        sp.toCamera = normalizeOr(ctx_.camera.position() - sp.position, sp.tangent);
+        sp.strand = s_.strandOf[local];
+        sp.segment = k;
+        return sp;
+    }
+
+    /// A strand vertex, independent of the tile and segment it is shaded for
+    /// (so that tiles sharing it agree).
+    ShadingPoint pointAtVertex(std::uint32_t point, std::uint32_t strand) const {
+        ShadingPoint sp;
+        sp.position = ctx_.groom.points[point];
+        sp.tangent = ctx_.tangents[point];
+        sp.toCamera = normalizeOr(ctx_.camera.position() - sp.position, sp.tangent);
+        sp.strand = strand;
+        sp.segment = point + 1 < ctx_.groom.strandStart[strand + 1] ? point : point - 1;
+        return sp;
+    }
+
+    /// Shades `count` points from s_.points; rejects invalid results (zeroing
+    /// them) and reports them with `where(i)`.
+    template <typename Where>
+    void shadeBatch(std::size_t count, Where&& where) {
+        s_.results.resize(count);
+        s_.terms.resize(count * lights_);
+        ctx_.shader.shade(std::span(s_.points.data(), count), std::span(s_.results.data(), count),
+                          std::span(s_.terms.data(), count * lights_));
+        result_.shadingPoints += count;
+        for (std::size_t i = 0; i < count; ++i) {
+            const std::span<GlobalTerm> terms(s_.terms.data() + i * lights_, lights_);
+            if (isValid(s_.results[i], terms))
+                continue;
+            ++result_.invalid;
+            if (result_.warnings.size() < kMaxWarnings)
+                result_.warnings.push_back(
+                    strCat("shader returned a non-finite or negative value ", where(i), " for ",
+                           s_.points[i], ": ", s_.results[i], "; set to black"));
+            s_.results[i] = ShadeResult{};
+            std::fill(terms.begin(), terms.end(), kZeroTerm);
+        }
+    }
+
+    /// Adds a shaded fragment to its pixel's sums.
+    void accumulate(const Visible& v, const ShadeResult& r, std::span<const GlobalTerm> terms) {
+        addWeighted(s_.pixelSum[v.pixel], r, v.weight);
+        GlobalTerm* sums = s_.pixelTerms.data() + std::size_t(v.pixel) * lights_;
+        for (std::size_t l = 0; l < lights_; ++l) {
+            GlobalTerm& a = sums[l];
+            const GlobalTerm& g = terms[l];
+            a.V += v.weight * g.V;
+            a.n += v.weight * g.n;
+            a.T_s += v.weight * g.T_s;
+            a.sigma2_f += v.weight * safeSqrt(g.sigma2_f); // σ_f, averaged
+        }
+    }
+
+    std::string pixelName(std::uint32_t pixel) const {
+        return strCat("at pixel (", x0_ + int(pixel % std::uint32_t(width_)), ", ",
+                      y0_ + int(pixel / std::uint32_t(width_)), ")");
+    }
+
+    void shadeFragments() {
+        s_.pixelSum.assign(area_, ShadeResult{});
+        s_.pixelTerms.assign(area_ * lights_, kZeroTerm);
+        for (std::size_t begin = 0; begin < s_.visible.size(); begin += kShadeBatch) {
+            const std::size_t count = std::min(kShadeBatch, s_.visible.size() - begin);
+            s_.points.resize(count);
+            for (std::size_t i = 0; i < count; ++i) {
+                const Visible& v = s_.visible[begin + i];
+                s_.points[i] = pointOnSegment(v.local, v.t);
+            }
+            shadeBatch(count,
+                       [&](std::size_t i) { return pixelName(s_.visible[begin + i].pixel); });
+            for (std::size_t i = 0; i < count; ++i)
+                accumulate(s_.visible[begin + i], s_.results[i],
+                           std::span(s_.terms.data() + i * lights_, lights_));
+        }
+    }
+
+    void shadeVertices() {
+        s_.pixelSum.assign(area_, ShadeResult{});
+        s_.pixelTerms.assign(area_ * lights_, kZeroTerm);
+        // Vertex slots of the segments with a visible fragment, in segment
+        // order; a segment's tip-side vertex is always the slot after its
+        // root-side one, which the next segment of the strand reuses.
+        constexpr std::uint32_t none = std::numeric_limits<std::uint32_t>::max();
+        s_.vertexSlot.assign(bins_.size(), none);
+        for (const Visible& v : s_.visible)
+            s_.vertexSlot[v.local] = 0;
+        s_.slotPoint.clear();
+        s_.slotStrand.clear();
+        for (std::size_t i = 0; i < bins_.size(); ++i) {
+            if (s_.vertexSlot[i] == none)
+                continue;
+            const std::uint32_t k = s_.pointOf[i];
+            if (s_.slotPoint.empty() || s_.slotPoint.back() != k) {
+                s_.slotPoint.push_back(k);
+                s_.slotStrand.push_back(s_.strandOf[i]);
+            }
+            s_.vertexSlot[i] = static_cast<std::uint32_t>(s_.slotPoint.size() - 1);
+            s_.slotPoint.push_back(k + 1);
+            s_.slotStrand.push_back(s_.strandOf[i]);
+        }
+        const std::size_t slots = s_.slotPoint.size();
+        s_.vertexResults.resize(slots);
+        s_.vertexTerms.resize(slots * lights_);
+        for (std::size_t begin = 0; begin < slots; begin += kShadeBatch) {
+            const std::size_t count = std::min(kShadeBatch, slots - begin);
+            s_.points.resize(count);
+            for (std::size_t i = 0; i < count; ++i)
+                s_.points[i] = pointAtVertex(s_.slotPoint[begin + i], s_.slotStrand[begin + i]);
+            shadeBatch(count, [&](std::size_t) { return std::string("at a strand vertex"); });
+            std::copy_n(s_.results.begin(), count,
+                        s_.vertexResults.begin() + std::ptrdiff_t(begin));
+            std::copy_n(s_.terms.begin(), count * lights_,
+                        s_.vertexTerms.begin() + std::ptrdiff_t(begin * lights_));
+        }
+        std::vector<GlobalTerm>& terms = s_.fragmentTerms;
+        terms.resize(lights_);
+        for (const Visible& v : s_.visible) {
+            const std::uint32_t slot = s_.vertexSlot[v.local];
+            const ShadeResult r = lerp(v.t, s_.vertexResults[slot], s_.vertexResults[slot + 1]);
+            for (std::size_t l = 0; l < lights_; ++l)
+                terms[l] = lerp(v.t, s_.vertexTerms[slot * lights_ + l],
+                                s_.vertexTerms[(slot + 1) * lights_ + l]);
+            accumulate(v, r, terms);
+        }
+    }
+
+    /// Radiance layers get the premultiplied sums; per-light AOVs the sums
+    /// divided by the hair's weight (averages).
+    void finishShading() {
+        const std::size_t pixels = film_.pixelCount();
+        for (std::uint32_t p = 0; p < area_; ++p) {
+            const float w = s_.pixels[p].hairWeight;
+            if (!(w > 0))
+                continue;
+            const std::size_t i = filmIndex(p);
+            const ShadeResult& r = s_.pixelSum[p];
+            film_.directR[i] = r.directR;
+            film_.directTT[i] = r.directTT;
+            film_.directTRT[i] = r.directTRT;
+            film_.backDirect[i] = r.backDirect;
+            film_.scatter[i] = r.scatter;
+            for (std::size_t l = 0; l < lights_; ++l) {
+                const GlobalTerm& a = s_.pixelTerms[std::size_t(p) * lights_ + l];
+                const std::size_t j = l * pixels + i;
+                film_.V[j] = a.V / w;
+                film_.n[j] = a.n / w;
+                film_.T_s[j] = a.T_s / w;
+                film_.sigma_f[j] = a.sigma2_f / w;
+            }
+        }
+    }
+
+    const RenderContext& ctx_;
+    TileScratch& s_;
+    Film& film_;
+    std::size_t lights_;
+    int x0_, y0_, x1_, y1_, width_;
+    std::uint32_t area_;
+    std::span<const std::uint32_t> bins_;
+    std::size_t openPixels_ = 0;
+    TileResult result_;
+};
+
+} // namespace
+
+std::ostream& operator<<(std::ostream& os, const RenderStats& s) {
+    return os << "RenderStats(" << s.seconds << " s: setup " << s.setupSeconds << " s, raster "
+              << s.rasterSeconds << " s, shade " << s.shadeSeconds << " s; " << s.segments
+              << " segments, " << s.segmentsOutsideView << " outside the view, "
+              << s.segmentsBehindHead << " behind the head, " << s.segmentTileRefs
+              << " segment-tile pairs; " << s.fragments << " fragments, "
+              << s.fragmentsComposited << " composited, " << s.fragmentsBehindOpaque
+              << " behind opaque pixels; " << s.shadingPoints << " shading points, "
+              << s.invalidSamples << " rejected; " << s.tiles << " tiles)";
+}
+
+RenderOutput renderImage(const Groom& groom, const Scene& scene, const FragmentShader& shader,
+                         const RenderOptions& options) {
+    const Clock::time_point start = Clock::now();
+    scene.validate();
+    if (!(options.opaqueTransmittance >= 0.0f && options.opaqueTransmittance < 1.0f))
+        throw InputError(strCat("opaque transmittance ", options.opaqueTransmittance,
+                                ": expected a number in [0, 1)"));
+    if (groom.pointCount() >= std::numeric_limits<std::uint32_t>::max())
+        throw InputError(strCat("groom: ", groom.pointCount(), " points: expected fewer than 2^32"));
+    const ThreadLimit threadLimit(options.threads);
+
+    RenderContext ctx(groom, scene, shader, options);
+    std::vector<std::string> lightNames;
+    for (const Light& light : scene.lights)
+        lightNames.push_back(light.name);
+    RenderOutput out;
+    out.film = Film(ctx.camera.width(), ctx.camera.height(), std::move(lightNames));
+    ctx.film = &out.film;
+    if (scene.head)
+        ctx.head.emplace(*scene.head, ctx.camera, scene.lights);
+
+    prepareVertices(groom, ctx.camera, ctx.fiberRadius, ctx.tangents, ctx.projected);
+    ctx.firstPoint = segmentFirstPoints(groom);
+    ctx.tilesX = (ctx.camera.width() + kTileSize - 1) / kTileSize;
+    ctx.tilesY = (ctx.camera.height() + kTileSize - 1) / kTileSize;
+    binSegments(ctx, out.stats);
+    out.stats.setupSeconds = secondsSince(start);
+
+    const int tiles = ctx.tilesX * ctx.tilesY;
+    std::vector<TileResult> results(static_cast<std::size_t>(tiles));
+    tbb::enumerable_thread_specific<TileScratch> scratch;
+    ProgressReporter progress("render", static_cast<std::uint64_t>(tiles), options.progress);
+    const Clock::time_point tilesStart = Clock::now();
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, tiles, 1), [&](const tbb::blocked_range<int>& range) {
+            for (int tile = range.begin(); tile != range.end(); ++tile) {
+                throwIfInterrupted();
+                results[std::size_t(tile)] = TileRenderer(ctx, scratch.local(), tile).run();
+                progress.update();
+            }
+        });
+    progress.finish();
+    const double tilesSeconds = secondsSince(tilesStart);
+
+    RenderStats& st = out.stats;
+    double rasterThread = 0, shadeThread = 0;
+    for (TileResult& r : results) {
+        rasterThread += r.rasterSeconds;
+        shadeThread += r.shadeSeconds;
+        st.fragments += r.fragments;
+        st.fragmentsBehindOpaque += r.behindOpaque;
+        st.segmentTilesSkipped += r.segmentsSkipped;
+        st.fragmentsComposited += r.composited;
+        st.shadingPoints += r.shadingPoints;
+        st.invalidSamples += r.invalid;
+        for (std::string& w : r.warnings)
+            if (out.warnings.size() < kMaxWarnings)
+                out.warnings.push_back(std::move(w));
+    }
+    if (st.invalidSamples > out.warnings.size())
+        out.warnings.push_back(strCat(st.invalidSamples - out.warnings.size(),
+                                      " more shader results were rejected"));
+    const double threadTotal = rasterThread + shadeThread;
+    st.rasterSeconds = threadTotal > 0 ? tilesSeconds * rasterThread / threadTotal : 0;
+    st.shadeSeconds = tilesSeconds - st.rasterSeconds;
+    st.tiles = static_cast<std::uint64_t>(tiles);
+    st.seconds = secondsSince(start);
+    return out;
+}
+
+} // namespace hairvox

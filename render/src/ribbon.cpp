@@ -1,0 +1,151 @@
+#include "ribbon.h"
+
+#include <hairvox/core/math.h>
+
+namespace hairvox::raster {
+
+namespace {
+
+/// Raster-space direction of the projected tangent u at camera-space point pc
+/// (the derivative of Camera::toRaster along u), unnormalised.
+Vec2d projectedTangent(const Vec3f& pc, const Vec3f& uc) {
+    const Vec3d p(pc), u(uc);
+    return {(u.x * p.z - p.x * u.z) / (p.z * p.z), -(u.y * p.z - p.y * u.z) / (p.z * p.z)};
+}
+
+} // namespace
+
+bool isConvexQuad(const Vec2d q[4]) {
+    bool positive = false, negative = false;
+    for (int k = 0; k < 4; ++k) {
+        const Vec2d e0 = q[(k + 1) % 4] - q[k];
+        const Vec2d e1 = q[(k + 2) % 4] - q[(k + 1) % 4];
+        const double cross = e0.x * e1.y - e0.y * e1.x;
+        positive |= cross > 0;
+        negative |= cross < 0;
+    }
+    return !(positive && negative);
+}
+
+void ScreenRibbon::locate(const Vec2d& c, float& t, float& depth) const {
+    const Vec2d d = s1 - s0;
+    const double len2 = glm::dot(d, d);
+    const double ts = len2 > 1e-18 ? std::clamp(glm::dot(c - s0, d) / len2, 0.0, 1.0) : 0.5;
+    // 1/z is affine in raster space; the 3D parameter is perspective-correct.
+    const double invZ = (1.0 - ts) * double(invZ0) + ts * double(invZ1);
+    const double tw = ts * double(invZ1) / invZ;
+    depth = static_cast<float>(1.0 / invZ);
+    t = static_cast<float>((1.0 - tw) * double(t0) + tw * double(t1));
+}
+
+namespace {
+
+/// The ribbon's half-width offset at a vertex: perpendicular to the projected
+/// tangent (or to `fallback` when the tangent points at the camera), of
+/// length f · radius / z.
+Vec2d ribbonOffset(const Vec3f& pc, const Vec3f& uc, double focal, double radius,
+                   const Vec2d& fallback) {
+    Vec2d d = projectedTangent(pc, uc);
+    double len = glm::length(d);
+    if (!(len > 1e-9)) {
+        d = fallback;
+        len = glm::length(d);
+        if (!(len > 1e-12)) {
+            d = Vec2d(1.0, 0.0);
+            len = 1.0;
+        }
+    }
+    return Vec2d(-d.y, d.x) * (focal * radius / (double(pc.z) * len));
+}
+
+void setBounds(ScreenRibbon& r) {
+    const Vec2d q[4] = {r.s0 + r.o0, r.s1 + r.o1, r.s1 - r.o1, r.s0 - r.o0};
+    r.xMin = r.xMax = q[0].x;
+    r.yMin = r.yMax = q[0].y;
+    for (int k = 1; k < 4; ++k) {
+        r.xMin = std::min(r.xMin, q[k].x);
+        r.xMax = std::max(r.xMax, q[k].x);
+        r.yMin = std::min(r.yMin, q[k].y);
+        r.yMax = std::max(r.yMax, q[k].y);
+    }
+}
+
+} // namespace
+
+void projectStrand(const Camera& camera, std::span<const Vec3f> points,
+                   std::span<const Vec3f> tangents, float radius, float zNear,
+                   std::span<ProjectedVertex> out) {
+    const double focal = camera.focalLength();
+    const std::size_t n = points.size();
+    for (std::size_t k = 0; k < n; ++k) {
+        const Vec3f pc = camera.toCamera(points[k]);
+        out[k].invZ = pc.z >= zNear ? 1.0f / pc.z : 0.0f;
+        out[k].raster = pc.z >= zNear ? Vec2d(camera.toRaster(pc)) : Vec2d(0.0);
+    }
+    for (std::size_t k = 0; k < n; ++k) {
+        if (!out[k].valid())
+            continue;
+        // Fallback direction: toward a projected neighbour.
+        Vec2d fallback(0.0);
+        if (k + 1 < n && out[k + 1].valid())
+            fallback = out[k + 1].raster - out[k].raster;
+        else if (k > 0 && out[k - 1].valid())
+            fallback = out[k].raster - out[k - 1].raster;
+        out[k].offset = ribbonOffset(camera.toCamera(points[k]),
+                                     camera.directionToCamera(tangents[k]), focal, radius,
+                                     fallback);
+    }
+}
+
+ScreenRibbon ribbonBetween(const ProjectedVertex& a, const ProjectedVertex& b) {
+    ScreenRibbon r;
+    r.s0 = a.raster;
+    r.s1 = b.raster;
+    r.o0 = a.offset;
+    r.o1 = b.offset;
+    r.invZ0 = a.invZ;
+    r.invZ1 = b.invZ;
+    r.t0 = 0.0f;
+    r.t1 = 1.0f;
+    setBounds(r);
+    return r;
+}
+
+std::optional<ScreenRibbon> projectRibbon(const Camera& camera, const Vec3f& p0, const Vec3f& p1,
+                                          const Vec3f& u0, const Vec3f& u1, float radius,
+                                          float zNear) {
+    Vec3f c0 = camera.toCamera(p0), c1 = camera.toCamera(p1);
+    if (c0.z < zNear && c1.z < zNear)
+        return std::nullopt;
+    Vec3f v0 = camera.directionToCamera(u0), v1 = camera.directionToCamera(u1);
+    ScreenRibbon r;
+    r.t0 = 0.0f;
+    r.t1 = 1.0f;
+    if (c0.z < zNear || c1.z < zNear) {
+        const float t = (zNear - c0.z) / (c1.z - c0.z);
+        const Vec3f c = c0 + t * (c1 - c0);
+        const Vec3f v = lerp(t, v0, v1); // only its projected direction matters
+        if (c0.z < zNear) {
+            c0 = c;
+            v0 = v;
+            r.t0 = t;
+        } else {
+            c1 = c;
+            v1 = v;
+            r.t1 = t;
+        }
+        c0.z = std::max(c0.z, zNear);
+        c1.z = std::max(c1.z, zNear);
+    }
+    const double focal = camera.focalLength();
+    r.s0 = Vec2d(camera.toRaster(c0));
+    r.s1 = Vec2d(camera.toRaster(c1));
+    r.invZ0 = 1.0f / c0.z;
+    r.invZ1 = 1.0f / c1.z;
+    r.o0 = ribbonOffset(c0, v0, focal, radius, r.s1 - r.s0);
+    r.o1 = ribbonOffset(c1, v1, focal, radius, r.s1 - r.s0);
+    setBounds(r);
+    return r;
+}
+
+} // namespace hairvox::raster

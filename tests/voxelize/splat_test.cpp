@@ -1,0 +1,413 @@
+#include "voxelize/voxelize_test_util.h"
+
+#include <hairvox/core/error.h>
+#include <hairvox/core/hash.h>
+#include <hairvox/core/rng.h>
+#include <hairvox/strands/procedural.h>
+
+#include <openvdb/tools/Interpolation.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+namespace hairvox {
+namespace {
+
+using openvdb::Coord;
+
+Groom groomOf(const std::vector<std::vector<Vec3f>>& strands) {
+    Groom g;
+    for (const auto& s : strands)
+        g.addStrand(s);
+    return g;
+}
+
+SplatOptions withVoxelSize(double h, bool tensor = false) {
+    SplatOptions o;
+    o.voxelSize = h;
+    o.storeOrientationTensor = tensor;
+    return o;
+}
+
+float density(const FiberGrid& g, const Coord& c) { return g.density->tree().getValue(c); }
+openvdb::Vec3s orientation(const FiberGrid& g, const Coord& c) {
+    return g.orientation->tree().getValue(c);
+}
+
+void expectVecNear(const openvdb::Vec3s& v, const Vec3d& expected, double tol, const Coord& c) {
+    EXPECT_NEAR(v.x(), expected.x, tol) << "at " << c;
+    EXPECT_NEAR(v.y(), expected.y, tol) << "at " << c;
+    EXPECT_NEAR(v.z(), expected.z, tol) << "at " << c;
+}
+
+/// Every active voxel: orientation = u and E[u uᵀ] = u uᵀ.
+void expectSingleDirection(const FiberGrid& g, const Vec3d& u) {
+    ASSERT_TRUE(g.hasTensor());
+    ASSERT_GT(g.activeVoxelCount(), 0u);
+    for (auto it = g.density->cbeginValueOn(); it; ++it) {
+        const Coord c = it.getCoord();
+        expectVecNear(orientation(g, c), u, 1e-5, c);
+        expectVecNear(g.tensorDiag->tree().getValue(c), u * u, 1e-5, c);
+        expectVecNear(g.tensorOffDiag->tree().getValue(c), Vec3d(u.x * u.y, u.x * u.z, u.y * u.z),
+                      1e-5, c);
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Exact values of the vertex-centred trilinear splat.
+
+TEST(Splat, FiberOnALatticeLineGivesItsLineDensity) {
+    // A fiber along each axis on a line of voxels, from −5h to 5h, in uneven
+    // segments: each voxel within gets ∫ tent = h of length (λ = 1/h²), the
+    // end voxels half of that, and no other voxel anything.
+    constexpr double h = 0.5;
+    for (int axis = 0; axis < 3; ++axis) {
+        std::vector<Vec3f> pts;
+        for (float x : {-2.5f, -1.3f, 0.1f, 0.6f, 2.5f}) {
+            Vec3f p(0.0f);
+            p[axis] = x;
+            pts.push_back(p);
+        }
+        const FiberGrid g = splatStrands(groomOf({pts}), withVoxelSize(h));
+        EXPECT_EQ(g.activeVoxelCount(), 11u) << "axis " << axis;
+        for (int i = -5; i <= 5; ++i) {
+            Coord c(0, 0, 0);
+            c[std::size_t(axis)] = i;
+            const double expected = (std::abs(i) == 5 ? 0.5 : 1.0) / (h * h);
+            EXPECT_NEAR(density(g, c), expected, 1e-6 * expected) << "axis " << axis << " " << c;
+            Vec3d u(0.0);
+            u[axis] = 1;
+            expectVecNear(orientation(g, c), u, 1e-6, c);
+        }
+    }
+}
+
+TEST(Splat, OffLatticeFiberSplitsByTrilinearWeights) {
+    // Along x at y = 0.25h, z = 0.6h: the voxel rows j, k ∈ {0, 1} get the
+    // line density times (0.75, 0.25) in y and (0.4, 0.6) in z.
+    constexpr double h = 0.5;
+    const float y = 0.125f, z = 0.3f;
+    const FiberGrid g = splatStrands(groomOf({{{0.0f, y, z}, {5.0f, y, z}}}), withVoxelSize(h));
+    EXPECT_EQ(g.activeVoxelCount(), 11u * 4u);
+    const double fy = double(y) / h, fz = double(z) / h;
+    const double wy[2] = {1 - fy, fy}, wz[2] = {1 - fz, fz};
+    for (int i = 0; i <= 10; ++i)
+        for (int j = 0; j <= 1; ++j)
+            for (int k = 0; k <= 1; ++k) {
+                const double line = (i == 0 || i == 10 ? 0.5 : 1.0) / (h * h);
+                const double expected = line * wy[j] * wz[k];
+                EXPECT_NEAR(density(g, Coord(i, j, k)), expected, 1e-5 * expected)
+                    << Coord(i, j, k);
+            }
+}
+
+TEST(Splat, FiberOnABrickBoundaryPlaneStaysOnItsVoxels) {
+    // x = 16 is voxel plane 32 at h = 0.5, the boundary between two 32³
+    // bricks: all length goes to i = 32, none to the neighbouring planes.
+    constexpr double h = 0.5;
+    const FiberGrid g =
+        splatStrands(groomOf({{{16.0f, -3.0f, 0.0f}, {16.0f, 3.0f, 0.0f}}}), withVoxelSize(h));
+    EXPECT_EQ(g.activeVoxelCount(), 13u);
+    for (auto it = g.density->cbeginValueOn(); it; ++it)
+        EXPECT_EQ(it.getCoord().x(), 32) << it.getCoord();
+    EXPECT_NEAR(density(g, Coord(32, 0, 0)), 1 / (h * h), 1e-6 / (h * h));
+    EXPECT_NEAR(test::splattedLength(g), 6.0, 6e-6);
+}
+
+TEST(Splat, TrilinearSamplingIsTheVertexCentredReconstruction) {
+    // Voxel ijk is the value at world ijk·h: OpenVDB's BoxSampler through the
+    // grid's transform returns it there, and interpolates between voxels.
+    const double h = 0.37;
+    const FiberGrid g = splatStrands(groomOf({{{0.1f, 0.2f, 0.3f}, {2.9f, 1.7f, 0.8f}}}),
+                                     withVoxelSize(h));
+    openvdb::tools::GridSampler<openvdb::FloatGrid, openvdb::tools::BoxSampler> sampler(*g.density);
+    // BoxSampler interpolates in float: compare relative to the largest value.
+    const double tol = 1e-6 / (h * h);
+    for (auto it = g.density->cbeginValueOn(); it; ++it) {
+        const Coord c = it.getCoord();
+        const openvdb::Vec3d world = openvdb::Vec3d(c.x(), c.y(), c.z()) * h;
+        const double value = *it, next = density(g, c.offsetBy(1, 0, 0));
+        EXPECT_NEAR(sampler.wsSample(world), value, tol) << c;
+        EXPECT_NEAR(sampler.wsSample(world + openvdb::Vec3d(0.5 * h, 0, 0)), 0.5 * (value + next),
+                    tol)
+            << c;
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Orientation and its second moment.
+
+TEST(Splat, SingleFiberOrientationIsItsDirection) {
+    const std::vector<Vec3d> directions = {
+        {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {-1, 0, 0}, glm::normalize(Vec3d(1, 1, 1)),
+        glm::normalize(Vec3d(-0.3, 0.8, -0.52))};
+    for (const Vec3d& u : directions) {
+        const Vec3f start(0.13f, -0.21f, 0.34f);
+        const Vec3f end = start + Vec3f(2.7 * u);
+        const FiberGrid g = splatStrands(groomOf({{start, end}}), withVoxelSize(0.23, true));
+        SCOPED_TRACE(testing::Message() << "u = " << u);
+        expectSingleDirection(g, glm::normalize(Vec3d(end) - Vec3d(start)));
+    }
+}
+
+TEST(Splat, CrossingPerpendicularFibersAverage) {
+    // Fibers along x and y crossing at voxel 0: there each brings length h,
+    // so λ = 2/h², E[u] = (½, ½, 0) (|E[u]| = 0.707: coherence drops) and
+    // E[u uᵀ] = diag(½, ½, 0). Voxels that only one fiber reaches keep it.
+    constexpr double h = 0.25;
+    const FiberGrid g = splatStrands(groomOf({{{-1.0f, 0.0f, 0.0f}, {1.0f, 0.0f, 0.0f}},
+                                              {{0.0f, -1.0f, 0.0f}, {0.0f, 1.0f, 0.0f}}}),
+                                     withVoxelSize(h, true));
+    const Coord o(0, 0, 0);
+    EXPECT_NEAR(density(g, o), 2 / (h * h), 1e-6 / (h * h));
+    expectVecNear(orientation(g, o), {0.5, 0.5, 0}, 1e-6, o);
+    expectVecNear(g.tensorDiag->tree().getValue(o), {0.5, 0.5, 0}, 1e-6, o);
+    expectVecNear(g.tensorOffDiag->tree().getValue(o), {0, 0, 0}, 1e-6, o);
+    for (const Coord& c : {Coord(2, 0, 0), Coord(-3, 0, 0)})
+        expectVecNear(orientation(g, c), {1, 0, 0}, 1e-6, c);
+    expectVecNear(orientation(g, Coord(0, 3, 0)), {0, 1, 0}, 1e-6, Coord(0, 3, 0));
+}
+
+TEST(Splat, AntiparallelFibersCancelInTheMeanButNotInTheTensor) {
+    // The root → tip sign is kept: opposite fibers cancel in E[u], while the
+    // sign-free E[u uᵀ] still says "along x".
+    constexpr double h = 0.25;
+    const FiberGrid g = splatStrands(groomOf({{{-1.0f, 0.0f, 0.0f}, {1.0f, 0.0f, 0.0f}},
+                                              {{1.0f, 0.0f, 0.0f}, {-1.0f, 0.0f, 0.0f}}}),
+                                     withVoxelSize(h, true));
+    const Coord o(0, 0, 0);
+    EXPECT_NEAR(density(g, o), 2 / (h * h), 1e-6 / (h * h));
+    expectVecNear(orientation(g, o), {0, 0, 0}, 1e-6, o);
+    expectVecNear(g.tensorDiag->tree().getValue(o), {1, 0, 0}, 1e-6, o);
+}
+
+TEST(Splat, StatisticsOfRealGroomsAreBounded) {
+    // On wavy and curly grooms: λ > 0, |E[u]| ≤ 1, trace E[u uᵀ] = 1, and all
+    // grids share one topology.
+    for (GroomStyle style : {GroomStyle::Wavy, GroomStyle::Curly}) {
+        ProceduralGroomParams p;
+        p.style = style;
+        p.strands = 400;
+        const Groom groom = generateGroom(p);
+        const FiberGrid g = splatStrands(groom, withVoxelSize(0, true));
+        SCOPED_TRACE(toString(style));
+        EXPECT_TRUE(g.density->tree().hasSameTopology(g.orientation->tree()));
+        EXPECT_TRUE(g.density->tree().hasSameTopology(g.tensorDiag->tree()));
+        EXPECT_TRUE(g.density->tree().hasSameTopology(g.tensorOffDiag->tree()));
+        double minCoherence = 1;
+        for (auto it = g.density->cbeginValueOn(); it; ++it) {
+            const Coord c = it.getCoord();
+            ASSERT_GT(*it, 0.0f) << c;
+            const double coherence = orientation(g, c).length();
+            ASSERT_LE(coherence, 1 + 1e-5) << c;
+            minCoherence = std::min(minCoherence, coherence);
+            const openvdb::Vec3s diag = g.tensorDiag->tree().getValue(c);
+            ASSERT_NEAR(diag.x() + diag.y() + diag.z(), 1.0, 1e-5) << c;
+        }
+        EXPECT_LT(minCoherence, 0.9); // strands do cross somewhere
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Length conservation.
+
+/// Random walks with steps from 1/100 to 1.5 units in random directions.
+Groom randomGroom(std::uint64_t seed, const Vec3f& offset) {
+    Pcg32 rng(seed);
+    Groom g;
+    for (int s = 0; s < 20; ++s) {
+        std::vector<Vec3f> pts{offset + Vec3f(rng.uniform(-2, 2), rng.uniform(-2, 2), rng.uniform(-2, 2))};
+        const int n = 2 + static_cast<int>(rng.nextU32() % 11);
+        for (int k = 1; k < n; ++k) {
+            const float cosTheta = rng.uniform(-1, 1), phi = rng.uniform(0, 6.2831853f);
+            const float sinTheta = std::sqrt(1 - cosTheta * cosTheta);
+            const float step = 0.01f * std::pow(150.0f, rng.uniformFloat());
+            pts.push_back(pts.back() + step * Vec3f(sinTheta * std::cos(phi),
+                                                    sinTheta * std::sin(phi), cosTheta));
+        }
+        g.addStrand(pts);
+    }
+    return g;
+}
+
+TEST(Splat, ConservesLengthForAnyVoxelSizeAndPlacement) {
+    for (std::uint64_t seed = 1; seed <= 4; ++seed)
+        for (double h : {0.023, 0.11, 0.5, 1.7, 6.0})
+            for (const Vec3f& offset : {Vec3f(0.0f), Vec3f(0.5f, 0.25f, 0.125f) * float(h),
+                                        Vec3f(1000.3f, -20.7f, 5.1f)}) {
+                const Groom groom = randomGroom(seed, offset);
+                const FiberGrid g = splatStrands(groom, withVoxelSize(h));
+                const double exact = test::exactLength(groom);
+                EXPECT_NEAR(test::splattedLength(g) / exact, 1.0, 1e-5)
+                    << "seed " << seed << ", h " << h << ", offset " << offset;
+            }
+}
+
+TEST(Splat, ConservesLengthOnVoxelBoundaries) {
+    // h = 0.5 is exact in binary, so these segments lie exactly on voxel
+    // planes, lines and vertices, and on the planes between 32³ bricks (16).
+    constexpr double h = 0.5;
+    const std::vector<std::vector<Vec3f>> cases = {
+        {{0, 0, 0}, {2, 0, 0}},                   // along a line of voxels
+        {{0.2f, 0.5f, 0.1f}, {1.7f, 0.5f, 1.3f}}, // in a voxel plane
+        {{0, 0, 0}, {2, 2, 2}},                   // through voxel vertices
+        {{-1.5f, -1, -0.5f}, {1.5f, 1, 0.5f}},    // through vertices, across 0
+        {{0.1f, 0.1f, 0.1f}, {0.2f, 0.15f, 0.12f}}, // inside one cell
+        {{0, 0, 0}, {0.5f, 0, 0}},                // one cell edge exactly
+        {{0.5f, 0.1f, 0.2f}, {1.0f, 0.3f, 0.4f}}, // face to face
+        {{0.3f, 0.3f, 0.3f}, {0.3f, 0.3f, 0.3000001f}}, // very short
+        {{16, 0.3f, 0.2f}, {16, 5, 3}},           // in a brick boundary plane
+        {{16, 16, -3}, {16, 16, 3}},              // along a brick edge
+        {{15.9f, 15.9f, 15.9f}, {16.1f, 16.1f, 16.1f}}, // through a brick corner
+        {{-16, -16, -16}, {40, 33, 20}},          // across several bricks
+    };
+    for (const auto& c : cases) {
+        const Groom groom = groomOf({c});
+        const FiberGrid g = splatStrands(groom, withVoxelSize(h));
+        EXPECT_NEAR(test::splattedLength(g) / test::exactLength(groom), 1.0, 1e-5)
+            << c[0] << " -> " << c[1];
+        for (auto it = g.density->cbeginValueOn(); it; ++it)
+            ASSERT_GT(*it, 0.0f) << it.getCoord();
+    }
+}
+
+TEST(Splat, ConservesLengthOfProceduralGrooms) {
+    for (GroomStyle style : {GroomStyle::Straight, GroomStyle::Wavy, GroomStyle::Curly}) {
+        ProceduralGroomParams p;
+        p.style = style;
+        p.strands = 1000;
+        const Groom groom = generateGroom(p);
+        for (int across : {16, 256}) {
+            const FiberGrid g = splatStrands(groom, withVoxelSize(defaultVoxelSize(groom, across)));
+            EXPECT_NEAR(test::splattedLength(g) / test::exactLength(groom), 1.0, 1e-5)
+                << toString(style) << ", " << across << " voxels across";
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Determinism, provenance, defaults.
+
+TEST(Splat, BitIdenticalForAnyThreadCount) {
+    for (GroomStyle style : {GroomStyle::Wavy, GroomStyle::Curly}) {
+        ProceduralGroomParams p;
+        p.style = style;
+        p.strands = 3000;
+        const Groom groom = generateGroom(p);
+        SplatOptions options = withVoxelSize(0, true);
+        const FiberGrid one = test::splatWithThreads(groom, options, 1);
+        for (int threads : {2, 8})
+            EXPECT_TRUE(test::sameFiberGrid(one, test::splatWithThreads(groom, options, threads)))
+                << toString(style) << ", " << threads << " threads";
+        options.threaded = false;
+        EXPECT_TRUE(test::sameFiberGrid(one, splatStrands(groom, options))) << toString(style);
+    }
+}
+
+TEST(Splat, RecordsWhatTheGridWasMadeFrom) {
+    ProceduralGroomParams p;
+    p.strands = 50;
+    const Groom groom = generateGroom(p);
+    SplatOptions options;
+    options.fiberDiameter = 6e-5f;
+    options.densityScale = 3.0f;
+    options.sourceFile = "head.hair";
+    const FiberGrid g = splatStrands(groom, options);
+    EXPECT_EQ(g.info.voxelSize, defaultVoxelSize(groom));
+    EXPECT_EQ(g.info.fiberDiameter, 6e-5f);
+    EXPECT_EQ(g.info.densityScale, 3.0f);
+    EXPECT_EQ(g.info.sourceFile, "head.hair");
+    EXPECT_EQ(g.info.sourceHash, hexDigest(contentHash(groom)));
+    EXPECT_EQ(g.info.strands, 50u);
+    EXPECT_EQ(g.info.segments, groom.segmentCount());
+    EXPECT_NEAR(g.info.totalLength, test::exactLength(groom), 1e-9 * g.info.totalLength);
+    EXPECT_FALSE(g.info.version.empty());
+    EXPECT_FALSE(g.hasTensor());
+    EXPECT_TRUE(g.warnings.empty());
+    EXPECT_EQ(g.density->getName(), "density");
+    EXPECT_EQ(g.orientation->getName(), "orientation");
+    EXPECT_EQ(g.density->getGridClass(), openvdb::GRID_FOG_VOLUME);
+    EXPECT_EQ(g.density->transform(), *openvdb::math::Transform::createLinearTransform(g.info.voxelSize));
+}
+
+TEST(Splat, DefaultVoxelSizeIsTheLongestSideOverAFixedCount) {
+    const Groom groom = groomOf({{{0, 0, 0}, {1, 3, 2}}, {{-1, 0, 0}, {0, 0.5f, 0}}});
+    EXPECT_DOUBLE_EQ(defaultVoxelSize(groom), 3.0 / kDefaultVoxelsAcross);
+    EXPECT_DOUBLE_EQ(defaultVoxelSize(groom, 64), 3.0 / 64);
+    EXPECT_EQ(defaultVoxelSize(Groom{}), 1.0);
+    EXPECT_THROW(defaultVoxelSize(groom, 0), InputError);
+}
+
+// ---------------------------------------------------------------------------
+// Bad input.
+
+TEST(Splat, EmptyGroomGivesAnEmptyGridAndAWarning) {
+    for (const Groom& groom : {Groom{}, groomOf({{{1, 2, 3}, {1, 2, 3}}})}) {
+        const FiberGrid g = splatStrands(groom, SplatOptions{});
+        ASSERT_TRUE(g.density && g.orientation);
+        EXPECT_EQ(g.activeVoxelCount(), 0u);
+        EXPECT_EQ(g.warnings.size(), 1u);
+        EXPECT_EQ(g.info.totalLength, 0.0);
+    }
+}
+
+TEST(Splat, RefusesInvalidOptions) {
+    const Groom groom = groomOf({{{0, 0, 0}, {1, 0, 0}}});
+    for (double h : {-1.0, std::nan(""), HUGE_VAL})
+        EXPECT_THROW(splatStrands(groom, withVoxelSize(h)), InputError) << h;
+    SplatOptions o;
+    o.fiberDiameter = 0;
+    EXPECT_THROW(splatStrands(groom, o), InputError);
+    o = SplatOptions{};
+    o.densityScale = -2;
+    EXPECT_THROW(splatStrands(groom, o), InputError);
+}
+
+TEST(Splat, RefusesAVoxelSizeOverTheMemoryBudgetStatingTheEstimate) {
+    ProceduralGroomParams p;
+    p.strands = 200;
+    const Groom groom = generateGroom(p);
+    try {
+        splatStrands(groom, withVoxelSize(1e-9));
+        FAIL() << "voxel size 1e-9 was accepted";
+    } catch (const InputError& e) {
+        const std::string message = e.what();
+        EXPECT_NE(message.find("GiB"), std::string::npos) << message;
+        EXPECT_NE(message.find("budget"), std::string::npos) << message;
+    }
+    SplatOptions small;
+    small.memoryBudgetBytes = 1 << 20;
+    EXPECT_THROW(splatStrands(groom, small), InputError);
+    small.memoryBudgetBytes = 1ull << 30;
+    EXPECT_NO_THROW(splatStrands(groom, small));
+}
+
+TEST(Splat, RefusesCoordinatesBeyondTheIndexSpace) {
+    const Groom far = groomOf({{{1e6f, 0, 0}, {1e6f + 1, 0, 0}}});
+    EXPECT_THROW(splatStrands(far, withVoxelSize(1e-4)), InputError);
+}
+
+TEST(Splat, RefusesVoxelsBelowOpenVdbsSmallestTransform) {
+    // OpenVDB's linear transform needs h³ ≥ 3e-15: a groom small enough to
+    // pass the memory check still cannot be voxelized at h = 1e-6.
+    const Groom tiny = groomOf({{{0, 0, 0}, {1e-5f, 0, 0}}});
+    EXPECT_THROW(splatStrands(tiny, withVoxelSize(1e-6)), InputError);
+    EXPECT_THROW(splatStrands(Groom{}, withVoxelSize(1e-6)), InputError);
+    EXPECT_NO_THROW(splatStrands(tiny, withVoxelSize(2e-5)));
+}
+
+TEST(Splat, RefusesNonFinitePoints) {
+    Groom groom = groomOf({{{0, 0, 0}, {1, 0, 0}}, {{0, 1, 0}, {1, 1, 0}}});
+    groom.points[3].y = std::nanf("");
+    try {
+        splatStrands(groom, SplatOptions{});
+        FAIL() << "a NaN point was accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("strand 1, point 1"), std::string::npos) << e.what();
+    }
+}
+
+} // namespace
+} // namespace hairvox

@@ -1,0 +1,155 @@
+// hairvox voxelize: the fiber grid — strands splatted into sparse OpenVDB grids
+// of fiber length density and orientation, and its .vdb file form.
+//
+// The grid holds, per voxel, what the dual-scattering global term integrates
+// along a shadow ray (DESIGN.md §5; Zinke et al. 2008, Sadeghi & Tamstorf 2010
+// §2.1): the fiber length density λ and the distribution of fiber tangents u.
+//
+// Index space and reconstruction (vertex-centred; cf. OpenVDB doc/math.txt)
+// -------------------------------------------------------------------------
+//   Voxel (i,j,k) holds the value at world position (i,j,k)·h, h = voxelSize;
+//   every grid's transform is Transform::createLinearTransform(h) (uniform
+//   scale, no offset), so index space is world space divided by h.
+//   A value between voxels is the trilinear interpolation of the 8 voxels
+//   around it: openvdb::tools::BoxSampler in index space (GridSampler with
+//   BoxSampler in world space).
+//   Splatting is the adjoint of that reconstruction: a piece of fiber of
+//   length ds at x gives each voxel v the share w_v(x)·ds, w_v the trilinear
+//   (tent) weight of v at x, and the 8 weights sum to 1. Hence, exactly up to
+//   rounding,
+//       λ_v = (1/h³) ∫_fibers w_v(x(s)) ds        fiber length per unit volume (1/length²)
+//       Σ_v λ_v h³ = total fiber length,  and  ∫ (trilinear λ) dV = total fiber length.
+//   The integrals are exact: each segment is clipped to the cells it crosses
+//   (3D DDA); inside one cell each weight is a cubic polynomial of the line
+//   parameter, which Simpson's rule integrates exactly.
+//
+// Orientation statistics (per voxel, weighted by the same w_v ds)
+// ----------------------------------------------------------------
+//   orientation  o_v = E_v[u] = ∫ w_v u ds / ∫ w_v ds, not normalised:
+//                |o_v| ∈ [0, 1] is the coherence (1 where all fibers near v
+//                are parallel). Sign: u points root → tip as the groom stores
+//                it (DESIGN.md §2). Folding u into a hemisphere instead would
+//                depend on an arbitrary reference direction and jump where
+//                fibers are perpendicular to it; root → tip is the direction
+//                a combed groom is coherent in. Consequence: antiparallel
+//                fibers (a parting, strands folding back) cancel in o_v.
+//   tensor       T_v = E_v[u uᵀ] (optional): symmetric, trace 1, positive
+//                semidefinite and sign-free; E_v[(ω·u)²] = ωᵀ T_v ω exactly,
+//                so E[sin²θ] and E[cos²θ] toward any direction ω are exact
+//                where the mean tangent alone is biased (curls, crossings).
+//                Stored as tensorDiag = (xx, yy, zz), tensorOffDiag = (xy, xz, yz).
+//   Examples: one fiber of direction u: o = u, T = u uᵀ. Equal lengths of two
+//   perpendicular fibers along x and y: o = (½, ½, 0) (|o| = 0.707),
+//   T = diag(½, ½, 0). Equal lengths of antiparallel fibers: o = 0, T = u uᵀ.
+//   o and T are means, so they read directly; the length-weighted
+//   reconstruction of a per-fiber quantity g(u) at x is Σ_v w_v(x) λ_v E_v[g],
+//   i.e. interpolate λ·o (or λ·T) rather than λ and o separately.
+//
+// Voxels are active where λ is at least FLT_MIN; elsewhere every grid reads
+// its background 0. fiberDiameter D and densityScale k are recorded for the
+// consumers (optical depth λ·k·D·|ω×u|); λ itself counts modeled strands only.
+#pragma once
+
+#include <hairvox/strands/groom.h>
+
+#include <openvdb/openvdb.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace hairvox {
+
+/// Grid names in FiberGrid and in .vdb files.
+inline constexpr const char* kDensityGridName = "density";
+inline constexpr const char* kOrientationGridName = "orientation";
+inline constexpr const char* kTensorDiagGridName = "tensorDiag";
+inline constexpr const char* kTensorOffDiagGridName = "tensorOffDiag";
+
+/// What a fiber grid was made from; stored as metadata on every grid of a .vdb
+/// (names in fiber_grid_io.cpp: voxel_size, fiber_diameter, density_scale,
+/// source_file, source_hash, strands, segments, total_length, hairvox_version).
+struct FiberGridInfo {
+    double voxelSize = 0;        ///< h, world units (metres for the procedural grooms)
+    float fiberDiameter = 8e-5f; ///< D, world units (metadata for consumers; λ does not depend on it)
+    float densityScale = 1.0f;   ///< one modeled strand stands for k real hairs (metadata)
+    std::string sourceFile;      ///< as given to splatStrands (the CLI passes the input path)
+    std::string sourceHash;      ///< hexDigest(contentHash(groom))
+    std::uint64_t strands = 0, segments = 0;
+    double totalLength = 0; ///< Σ segment lengths of the groom, world units
+    std::string version;    ///< hairvox version that splatted the grid
+};
+
+std::ostream& operator<<(std::ostream& os, const FiberGridInfo& info);
+
+struct FiberGrid {
+    /// "density": λ, fiber length per unit volume (1/length²); GRID_FOG_VOLUME, background 0.
+    openvdb::FloatGrid::Ptr density;
+    /// "orientation": E[u], length-weighted mean unit tangent (root → tip), |·| ∈ [0, 1].
+    openvdb::Vec3SGrid::Ptr orientation;
+    /// "tensorDiag", "tensorOffDiag": E[u uᵀ] as (xx, yy, zz) and (xy, xz, yz);
+    /// both null when not stored (SplatOptions::storeOrientationTensor).
+    openvdb::Vec3SGrid::Ptr tensorDiag, tensorOffDiag;
+    FiberGridInfo info;
+    /// Notes for the user from splatStrands (e.g. an empty groom); not stored in files.
+    std::vector<std::string> warnings;
+
+    bool hasTensor() const { return tensorDiag != nullptr && tensorOffDiag != nullptr; }
+    /// Active voxels of the density grid (the other grids share its topology).
+    std::uint64_t activeVoxelCount() const;
+    /// In-memory size of all grids, bytes.
+    std::uint64_t memoryBytes() const;
+};
+
+std::ostream& operator<<(std::ostream& os, const FiberGrid& grid);
+
+/// The default voxel size is the longest side of the groom's bounding box
+/// divided by this. Why a count across the box: it does not depend on units
+/// or strand count, it bounds the work and memory (at most 256³ voxels, of
+/// which a head of hair fills a few percent), and it resolves the hair volume
+/// — a 30 cm groom gets ~1.2 mm voxels, i.e. ~10–20 voxels through a 1–3 cm
+/// layer of hair, the depth over which the forward-scattered light decays.
+/// The transmittance stage tunes this number against exact ray casting.
+inline constexpr int kDefaultVoxelsAcross = 256;
+
+/// Longest side of groom.bounds() / voxelsAcross. A groom without extent
+/// (empty, or all points coincident) gets 1: there is nothing to resolve.
+double defaultVoxelSize(const Groom& groom, int voxelsAcross = kDefaultVoxelsAcross);
+
+struct SplatOptions {
+    double voxelSize = 0;        ///< h > 0; 0 = defaultVoxelSize(groom)
+    float fiberDiameter = 8e-5f; ///< D > 0, recorded in FiberGridInfo
+    float densityScale = 1.0f;   ///< k > 0, recorded in FiberGridInfo
+    /// Also splat E[u uᵀ] (two more Vec3S grids, ~2.5× the memory); off until
+    /// the transmittance stage measures that it pays.
+    bool storeOrientationTensor = false;
+    bool threaded = true; ///< false runs on the calling thread only (same result)
+    /// splatStrands refuses, before allocating, a voxel size whose estimated
+    /// memory exceeds this.
+    std::uint64_t memoryBudgetBytes = 4ull << 30;
+    std::string sourceFile; ///< recorded in FiberGridInfo
+    bool showProgress = false; ///< progress bar on stderr
+};
+
+std::ostream& operator<<(std::ostream& os, const SplatOptions& options);
+
+/// Splats every segment of the groom (see the conventions above). The result is
+/// bit-identical for any thread count. An empty groom (or one without length)
+/// gives empty grids and a warning. Throws InputError for invalid options, a
+/// non-finite point, coordinates beyond OpenVDB's 32-bit index space at this
+/// voxel size, or an estimated memory above the budget (the message states the
+/// estimate). Polls throwIfInterrupted().
+FiberGrid splatStrands(const Groom& groom, const SplatOptions& options);
+
+/// Writes the grids with their metadata as one .vdb file, atomically.
+void writeFiberGrid(const std::filesystem::path& path, const FiberGrid& grid);
+
+/// Reads a .vdb written by writeFiberGrid. Throws InputError naming the file if
+/// it is unreadable, lacks the density or orientation grid or the hairvox
+/// metadata, has a transform other than the vertex-centred linear one, or holds
+/// non-finite or negative density values.
+FiberGrid readFiberGrid(const std::filesystem::path& path);
+
+} // namespace hairvox

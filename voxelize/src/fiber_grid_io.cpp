@@ -1,0 +1,185 @@
+// hairvox voxelize: the fiber grid as a .vdb file (fiber_grid.h).
+//
+// One file holds the grids "density", "orientation" and optionally
+// "tensorDiag" and "tensorOffDiag"; every grid carries FiberGridInfo as grid
+// metadata, so a grid copied out of the file alone keeps its provenance and
+// `vdb_print -l` or pyopenvdb show it. Counts are stored as int64 (the widest
+// integer pyopenvdb reads).
+#include <hairvox/core/atomic_file.h>
+#include <hairvox/core/error.h>
+#include <hairvox/voxelize/fiber_grid.h>
+
+#include <openvdb/io/File.h>
+
+#include <cmath>
+
+namespace hairvox {
+
+namespace {
+
+constexpr const char* kMetaVoxelSize = "voxel_size";
+constexpr const char* kMetaFiberDiameter = "fiber_diameter";
+constexpr const char* kMetaDensityScale = "density_scale";
+constexpr const char* kMetaSourceFile = "source_file";
+constexpr const char* kMetaSourceHash = "source_hash";
+constexpr const char* kMetaStrands = "strands";
+constexpr const char* kMetaSegments = "segments";
+constexpr const char* kMetaTotalLength = "total_length";
+constexpr const char* kMetaVersion = "hairvox_version";
+
+void addMetadata(openvdb::GridBase& grid, const FiberGridInfo& info) {
+    grid.insertMeta(kMetaVoxelSize, openvdb::DoubleMetadata(info.voxelSize));
+    grid.insertMeta(kMetaFiberDiameter, openvdb::FloatMetadata(info.fiberDiameter));
+    grid.insertMeta(kMetaDensityScale, openvdb::FloatMetadata(info.densityScale));
+    grid.insertMeta(kMetaSourceFile, openvdb::StringMetadata(info.sourceFile));
+    grid.insertMeta(kMetaSourceHash, openvdb::StringMetadata(info.sourceHash));
+    grid.insertMeta(kMetaStrands, openvdb::Int64Metadata(static_cast<std::int64_t>(info.strands)));
+    grid.insertMeta(kMetaSegments, openvdb::Int64Metadata(static_cast<std::int64_t>(info.segments)));
+    grid.insertMeta(kMetaTotalLength, openvdb::DoubleMetadata(info.totalLength));
+    grid.insertMeta(kMetaVersion, openvdb::StringMetadata(info.version));
+}
+
+/// Reads one metadata value of the grid; InputError naming the file if absent or mistyped.
+template <typename T>
+T metaValue(const openvdb::GridBase& grid, const char* name, const std::string& file) {
+    const auto meta = grid.getMetadata<openvdb::TypedMetadata<T>>(name);
+    if (!meta)
+        throw InputError(strCat(file, ": grid '", grid.getName(), "' has no ",
+                                openvdb::TypedMetadata<T>::staticTypeName(), " metadata '", name,
+                                "'; not a hairvox fiber grid"));
+    return meta->value();
+}
+
+FiberGridInfo readMetadata(const openvdb::GridBase& grid, const std::string& file) {
+    FiberGridInfo info;
+    info.voxelSize = metaValue<double>(grid, kMetaVoxelSize, file);
+    info.fiberDiameter = metaValue<float>(grid, kMetaFiberDiameter, file);
+    info.densityScale = metaValue<float>(grid, kMetaDensityScale, file);
+    info.sourceFile = metaValue<std::string>(grid, kMetaSourceFile, file);
+    info.sourceHash = metaValue<std::string>(grid, kMetaSourceHash, file);
+    const std::int64_t strands = metaValue<std::int64_t>(grid, kMetaStrands, file);
+    const std::int64_t segments = metaValue<std::int64_t>(grid, kMetaSegments, file);
+    info.totalLength = metaValue<double>(grid, kMetaTotalLength, file);
+    info.version = metaValue<std::string>(grid, kMetaVersion, file);
+    const auto bad = [&](const char* name, const auto& value, const char* range) {
+        return InputError(strCat(file, ": metadata ", name, " = ", value, " should be ", range));
+    };
+    if (!(std::isfinite(info.voxelSize) && info.voxelSize > 0))
+        throw bad(kMetaVoxelSize, info.voxelSize, "> 0");
+    if (!(std::isfinite(info.fiberDiameter) && info.fiberDiameter > 0))
+        throw bad(kMetaFiberDiameter, info.fiberDiameter, "> 0");
+    if (!(std::isfinite(info.densityScale) && info.densityScale > 0))
+        throw bad(kMetaDensityScale, info.densityScale, "> 0");
+    if (strands < 0)
+        throw bad(kMetaStrands, strands, ">= 0");
+    if (segments < 0)
+        throw bad(kMetaSegments, segments, ">= 0");
+    if (!(std::isfinite(info.totalLength) && info.totalLength >= 0))
+        throw bad(kMetaTotalLength, info.totalLength, ">= 0");
+    info.strands = static_cast<std::uint64_t>(strands);
+    info.segments = static_cast<std::uint64_t>(segments);
+    return info;
+}
+
+/// The named grid as GridT, null if absent; InputError if it has another type
+/// or a transform other than the vertex-centred one of voxel size h.
+template <typename GridT>
+typename GridT::Ptr readGrid(openvdb::io::File& in, const char* name, const std::string& file) {
+    if (!in.hasGrid(name))
+        return nullptr;
+    auto grid = openvdb::gridPtrCast<GridT>(in.readGrid(name));
+    if (!grid)
+        throw InputError(strCat(file, ": grid '", name, "' should be of type ",
+                                GridT::gridType()));
+    return grid;
+}
+
+template <typename GridT>
+void checkTransform(const GridT& grid, double h, const std::string& file) {
+    if (grid.transform() != *openvdb::math::Transform::createLinearTransform(h))
+        throw InputError(strCat(file, ": grid '", grid.getName(),
+                                "' should have a uniform linear transform of voxel size ", h,
+                                " without offset (vertex-centred voxels at ijk·h); it has ",
+                                grid.transform()));
+}
+
+template <typename GridT, typename Check>
+void checkValues(const GridT& grid, const std::string& file, const char* requirement,
+                 const Check& valid) {
+    for (auto it = grid.cbeginValueOn(); it; ++it)
+        if (!valid(*it))
+            throw InputError(strCat(file, ": grid '", grid.getName(), "' value ", *it, " at ",
+                                    it.getCoord(), " should be ", requirement));
+}
+
+bool finiteVec(const openvdb::Vec3s& v) {
+    return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
+}
+
+} // namespace
+
+void writeFiberGrid(const std::filesystem::path& path, const FiberGrid& grid) {
+    if (!grid.density || !grid.orientation)
+        throw std::invalid_argument("writeFiberGrid: the density and orientation grids are required");
+    openvdb::initialize();
+    // Shallow copies (shared trees) carry the metadata, leaving the caller's grids untouched.
+    openvdb::GridPtrVec grids;
+    for (const openvdb::GridBase::Ptr& g :
+         {openvdb::GridBase::Ptr(grid.density), openvdb::GridBase::Ptr(grid.orientation),
+          openvdb::GridBase::Ptr(grid.tensorDiag), openvdb::GridBase::Ptr(grid.tensorOffDiag)}) {
+        if (!g)
+            continue;
+        openvdb::GridBase::Ptr copy = g->copyGrid();
+        addMetadata(*copy, grid.info);
+        grids.push_back(copy);
+    }
+    writeFileAtomically(path, [&](const std::filesystem::path& tmp) {
+        try {
+            openvdb::io::File out(tmp.string());
+            out.write(grids);
+            out.close();
+        } catch (const openvdb::Exception& e) {
+            throw InputError(strCat(path.string(), ": cannot write: ", e.what()));
+        }
+    });
+}
+
+FiberGrid readFiberGrid(const std::filesystem::path& path) {
+    const std::string file = path.string();
+    openvdb::initialize();
+    FiberGrid grid;
+    try {
+        openvdb::io::File in(file);
+        in.open(/*delayLoad=*/false);
+        grid.density = readGrid<openvdb::FloatGrid>(in, kDensityGridName, file);
+        grid.orientation = readGrid<openvdb::Vec3SGrid>(in, kOrientationGridName, file);
+        grid.tensorDiag = readGrid<openvdb::Vec3SGrid>(in, kTensorDiagGridName, file);
+        grid.tensorOffDiag = readGrid<openvdb::Vec3SGrid>(in, kTensorOffDiagGridName, file);
+        in.close();
+        if (!grid.density || !grid.orientation)
+            throw InputError(strCat(file, ": a fiber grid needs the grids '", kDensityGridName,
+                                    "' and '", kOrientationGridName, "'"));
+        if ((grid.tensorDiag == nullptr) != (grid.tensorOffDiag == nullptr))
+            throw InputError(strCat(file, ": the grids '", kTensorDiagGridName, "' and '",
+                                    kTensorOffDiagGridName, "' come together; only one is present"));
+        grid.info = readMetadata(*grid.density, file);
+
+        const double h = grid.info.voxelSize;
+        checkTransform(*grid.density, h, file);
+        checkTransform(*grid.orientation, h, file);
+        checkValues(*grid.density, file, "finite and >= 0",
+                    [](float v) { return std::isfinite(v) && v >= 0; });
+        checkValues(*grid.orientation, file, "finite", finiteVec);
+        if (grid.hasTensor()) {
+            checkTransform(*grid.tensorDiag, h, file);
+            checkTransform(*grid.tensorOffDiag, h, file);
+            checkValues(*grid.tensorDiag, file, "finite", finiteVec);
+            checkValues(*grid.tensorOffDiag, file, "finite", finiteVec);
+        }
+    } catch (const openvdb::Exception& e) {
+        throw InputError(strCat(file, ": cannot read as a hairvox fiber grid: ", e.what()));
+    }
+    return grid;
+}
+
+} // namespace hairvox

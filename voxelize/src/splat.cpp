@@ -1,0 +1,782 @@
+// hairvox voxelize: splatting strands into the fiber grid (conventions in fiber_grid.h).
+//
+// The work is organised so that every voxel's value is a sum over the
+// segments in groom order, whatever the number of threads:
+//  1. Scan: validate the groom, total its length, estimate the memory and
+//     refuse a voxel size over the budget before anything big is allocated.
+//  2. Bucket: fixed chunks of strands (boundaries depend on the groom only)
+//     list in parallel, per segment, the bricks (32³-voxel blocks) whose
+//     voxels it can reach; a serial counting sort in chunk order then gives
+//     each brick its segments in groom order.
+//  3. Splat: bricks in parallel. A brick owns its 32³ voxels and computes them
+//     alone, from every cell that touches them (its own cells and a one-cell
+//     apron below it, which a neighbour also visits for its own voxels), into
+//     a dense double accumulator of one thread; then it emits OpenVDB leaves.
+//     No voxel is written by two bricks, so there is no merge step.
+//  4. The leaves are added to the trees serially (cheap: one per 512 voxels).
+#include <hairvox/core/error.h>
+#include <hairvox/core/hash.h>
+#include <hairvox/core/interrupt.h>
+#include <hairvox/core/parallel.h>
+#include <hairvox/core/progress.h>
+#include <hairvox/voxelize/fiber_grid.h>
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <cfloat>
+#include <cmath>
+#include <iomanip>
+#include <limits>
+#include <memory>
+#include <sstream>
+#include <unordered_map>
+
+#ifndef HAIRVOX_VERSION
+#error "HAIRVOX_VERSION must be defined by the build"
+#endif
+
+namespace hairvox {
+
+namespace {
+
+using FloatLeaf = openvdb::FloatTree::LeafNodeType;
+using Vec3SLeaf = openvdb::Vec3STree::LeafNodeType;
+using Vec3i = glm::ivec3;
+
+constexpr int kLeafDim = static_cast<int>(FloatLeaf::DIM); // 8
+/// Brick side in voxels: a multiple of the leaf size. 32 keeps the segments
+/// that reach two bricks rare (a default-size segment spans ~5 voxels) while
+/// one accumulator (34³ voxels × 4 doubles = 1.2 MiB) stays cache-friendly.
+constexpr int kBrickLog2 = 5;
+constexpr int kBrickSize = 1 << kBrickLog2;
+constexpr int kLeavesPerBrickSide = kBrickSize / kLeafDim;
+/// Accumulator side: voxels [brick origin − 1, brick origin + 32] hold the
+/// corners of the cells [origin − 1, origin + 31] that touch the brick's voxels.
+constexpr int kAccDim = kBrickSize + 2;
+/// Strands are grouped into chunks of at least this many segments for the
+/// scan and the bucketing (fixed by the groom, never by the thread count).
+constexpr std::size_t kChunkSegments = 16384;
+/// Coordinates must stay well inside OpenVDB's int32 index space.
+constexpr double kMaxIndex = 1 << 30;
+
+double formatGiB(double bytes) { return bytes / double(1ull << 30); }
+
+// ---------------------------------------------------------------------------
+// Running work in fixed chunks, in parallel or on the calling thread.
+
+template <typename F>
+void forEachIndex(std::size_t n, bool threaded, const F& f) {
+    if (!threaded) {
+        for (std::size_t i = 0; i < n; ++i)
+            f(i);
+        return;
+    }
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (std::size_t i = r.begin(); i != r.end(); ++i)
+                              f(i);
+                      });
+}
+
+struct StrandRange {
+    std::size_t begin = 0, end = 0; ///< strands [begin, end)
+};
+
+std::vector<StrandRange> strandChunks(const Groom& groom) {
+    std::vector<StrandRange> chunks;
+    StrandRange current;
+    std::size_t segments = 0;
+    for (std::size_t s = 0; s < groom.strandCount(); ++s) {
+        segments += groom.strandStart[s + 1] - groom.strandStart[s] - 1;
+        if (segments >= kChunkSegments) {
+            current.end = s + 1;
+            chunks.push_back(current);
+            current.begin = s + 1;
+            segments = 0;
+        }
+    }
+    if (current.begin < groom.strandCount()) {
+        current.end = groom.strandCount();
+        chunks.push_back(current);
+    }
+    return chunks;
+}
+
+// ---------------------------------------------------------------------------
+// Cell traversal (Amanatides & Woo 1987, "A Fast Voxel Traversal Algorithm").
+
+/// ⌊x⌋ for |x| < 2³¹, inline (std::floor is a libm call on baseline x86-64,
+/// and this runs several times per segment).
+int floorToInt(double x) {
+    const auto i = static_cast<int>(x);
+    return x < i ? i - 1 : i;
+}
+
+Vec3i floorToInt(const Vec3d& v) { return {floorToInt(v.x), floorToInt(v.y), floorToInt(v.z)}; }
+
+/// The segment a + t·d, t ∈ [0, 1], in index space, with 1/d per axis (0 on
+/// an axis the segment does not advance along, or too little for 1/d).
+struct IndexSegment {
+    Vec3d a, d, invD;
+
+    IndexSegment(const Vec3d& start, const Vec3d& delta) : a(start), d(delta) {
+        for (int i = 0; i < 3; ++i) {
+            const double inv = 1.0 / d[i];
+            invD[i] = std::isfinite(inv) ? inv : 0.0;
+        }
+    }
+    Vec3d at(double t) const { return a + t * d; }
+};
+
+/// Calls f(cell, tEnter, tExit) for the unit cells that segment s crosses for
+/// t ∈ [t0, t1], in order, skipping pieces of zero length (Amanatides & Woo
+/// 1987). Cell c is the cube [c, c + 1]. Cells are kept in [cellMin,
+/// cellMax]: the traversal stops if rounding would step outside (the caller
+/// clipped the segment to that range, so only a rounding-sized piece is lost).
+template <typename F>
+void traverseCells(const IndexSegment& s, double t0, double t1, const Vec3i& cellMin,
+                   const Vec3i& cellMax, const F& f) {
+    Vec3i cell, step;
+    Vec3d tNext;
+    const Vec3d x0 = s.at(t0);
+    for (int i = 0; i < 3; ++i) {
+        cell[i] = std::clamp(floorToInt(x0[i]), cellMin[i], cellMax[i]);
+        step[i] = s.invD[i] > 0 ? 1 : (s.invD[i] < 0 ? -1 : 0);
+        tNext[i] = step[i] == 0 ? std::numeric_limits<double>::infinity()
+                                : (cell[i] + (step[i] > 0 ? 1 : 0) - s.a[i]) * s.invD[i];
+    }
+    double t = t0;
+    for (;;) {
+        // The axis whose boundary comes first, written to compile without branches.
+        const bool xFirst = tNext.x < tNext.y;
+        const double tXY = xFirst ? tNext.x : tNext.y;
+        const int i = tNext.z < tXY ? 2 : (xFirst ? 0 : 1);
+        const double tExit = std::min(tNext[i], t1);
+        if (tExit > t) {
+            f(cell, t, tExit);
+            t = tExit;
+        }
+        if (tExit >= t1)
+            return;
+        cell[i] += step[i];
+        if (cell[i] < cellMin[i] || cell[i] > cellMax[i])
+            return;
+        // Recomputed from the boundary, not accumulated, so no drift on long segments.
+        tNext[i] = (cell[i] + (step[i] > 0 ? 1 : 0) - s.a[i]) * s.invD[i];
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Bricks and the bucketing of segments.
+
+struct BrickKey {
+    std::int32_t x = 0, y = 0, z = 0;
+    bool operator==(const BrickKey&) const = default;
+};
+
+struct BrickKeyHash {
+    std::size_t operator()(const BrickKey& k) const {
+        std::uint64_t h = std::uint64_t(std::uint32_t(k.x)) * 0x9e3779b97f4a7c15ull;
+        h ^= std::uint64_t(std::uint32_t(k.y)) * 0xc2b2ae3d27d4eb4full;
+        h ^= std::uint64_t(std::uint32_t(k.z)) * 0x165667b19e3779f9ull;
+        return h ^ (h >> 29);
+    }
+};
+
+/// The bricks whose voxels the segment from a to b (index space) can reach,
+/// appended to `out` without repeats. Brick B owns voxels [S·B, S·B + S − 1]
+/// and needs the cells [S·B − 1, S·B + S − 1]: the bricks the segment passes
+/// through plus, where it passes through a brick's last cell layer on some
+/// axes, the neighbours above on those axes. A superset is harmless (the
+/// brick clips the segment away).
+void bricksOfSegment(const Vec3d& a, const Vec3d& b, std::vector<BrickKey>& out) {
+    const auto add = [&](const BrickKey& key) {
+        if (std::find(out.begin(), out.end(), key) == out.end())
+            out.push_back(key);
+    };
+    // Fast path: the box of the cells the segment touches, widened to the
+    // bricks that need them, holds at most two bricks.
+    const Vec3i cellLo = floorToInt(glm::min(a, b)), cellHi = floorToInt(glm::max(a, b));
+    const Vec3i brickLo = cellLo >> kBrickLog2, brickHi = (cellHi + 1) >> kBrickLog2;
+    const Vec3i span = brickHi - brickLo + 1;
+    if (span.x * span.y * span.z <= 2) {
+        for (int x = brickLo.x; x <= brickHi.x; ++x)
+            for (int y = brickLo.y; y <= brickHi.y; ++y)
+                for (int z = brickLo.z; z <= brickHi.z; ++z)
+                    add({x, y, z});
+        return;
+    }
+    // Otherwise walk the bricks along the segment.
+    constexpr double invBrick = 1.0 / kBrickSize;
+    constexpr int big = std::numeric_limits<int>::max() / 2;
+    const IndexSegment inBricks(a * invBrick, (b - a) * invBrick);
+    traverseCells(inBricks, 0.0, 1.0, Vec3i(-big), Vec3i(big), [&](const Vec3i& brick, double tA, double tB) {
+        // Does the piece reach the brick's last cell layer on each axis? (Voxel
+        // units; the margin keeps the test conservative against rounding.)
+        Vec3i up(0);
+        for (int i = 0; i < 3; ++i) {
+            const double hi = std::max(a[i] + tA * (b[i] - a[i]), a[i] + tB * (b[i] - a[i]));
+            up[i] = hi >= double(brick[i] * kBrickSize + kBrickSize - 1) - 1e-6 ? 1 : 0;
+        }
+        for (int ex = 0; ex <= up.x; ++ex)
+            for (int ey = 0; ey <= up.y; ++ey)
+                for (int ez = 0; ez <= up.z; ++ez)
+                    add({brick.x + ex, brick.y + ey, brick.z + ez});
+    });
+}
+
+/// Consecutive segments of one strand that all reach one brick: points
+/// [begin, end) of the groom, end − begin ≥ 2. Runs rather than single
+/// segments keep the bucket lists short and the reads of the groom's points
+/// sequential.
+struct Run {
+    std::uint32_t begin = 0, end = 0;
+};
+
+struct BrickRun {
+    BrickKey brick;
+    Run run;
+};
+
+/// The runs of the strands of one chunk, in a fixed order.
+void runsOfChunk(const Groom& groom, const StrandRange& chunk, double invH,
+                 std::vector<BrickRun>& runs) {
+    struct Open {
+        BrickKey brick;
+        std::uint32_t begin;
+    };
+    std::vector<Open> open, stillOpen;
+    std::vector<BrickKey> keys;
+    for (std::size_t s = chunk.begin; s < chunk.end; ++s) {
+        const std::uint32_t first = groom.strandStart[s], last = groom.strandStart[s + 1] - 1;
+        for (std::uint32_t p = first; p < last; ++p) {
+            const Vec3f& p0 = groom.points[p];
+            const Vec3f& p1 = groom.points[p + 1];
+            if (p0 == p1)
+                continue; // no length: it neither starts nor ends a run
+            keys.clear();
+            bricksOfSegment(Vec3d(p0) * invH, Vec3d(p1) * invH, keys);
+            stillOpen.clear();
+            for (const Open& o : open) {
+                if (std::find(keys.begin(), keys.end(), o.brick) != keys.end())
+                    stillOpen.push_back(o);
+                else
+                    runs.push_back({o.brick, {o.begin, p + 1}});
+            }
+            for (const BrickKey& k : keys)
+                if (std::none_of(open.begin(), open.end(), [&](const Open& o) { return o.brick == k; }))
+                    stillOpen.push_back({k, p});
+            std::swap(open, stillOpen);
+        }
+        for (const Open& o : open)
+            runs.push_back({o.brick, {o.begin, last + 1}});
+        open.clear();
+    }
+}
+
+/// Runs grouped by brick, each brick's list in chunk order.
+struct BrickBuckets {
+    std::vector<BrickKey> bricks;
+    std::vector<std::size_t> start; ///< runs of brick b: [start[b], start[b + 1])
+    std::vector<Run> runs;
+};
+
+BrickBuckets bucketSegments(const Groom& groom, const std::vector<StrandRange>& chunks,
+                            double invH, bool threaded) {
+    std::vector<std::vector<BrickRun>> chunkRuns(chunks.size());
+    forEachIndex(chunks.size(), threaded, [&](std::size_t c) {
+        throwIfInterrupted();
+        runsOfChunk(groom, chunks[c], invH, chunkRuns[c]);
+    });
+
+    // Counting sort in chunk order; brick ids in order of first appearance.
+    BrickBuckets buckets;
+    std::unordered_map<BrickKey, std::uint32_t, BrickKeyHash> ids;
+    std::vector<std::uint32_t> runBrick;
+    std::vector<std::size_t> counts;
+    for (const auto& runs : chunkRuns)
+        for (const BrickRun& r : runs) {
+            const auto [it, inserted] = ids.try_emplace(r.brick, std::uint32_t(buckets.bricks.size()));
+            if (inserted) {
+                buckets.bricks.push_back(r.brick);
+                counts.push_back(0);
+            }
+            ++counts[it->second];
+            runBrick.push_back(it->second);
+        }
+    buckets.start.assign(buckets.bricks.size() + 1, 0);
+    for (std::size_t b = 0; b < counts.size(); ++b)
+        buckets.start[b + 1] = buckets.start[b] + counts[b];
+    std::vector<std::size_t> cursor(buckets.start.begin(), buckets.start.end() - 1);
+    buckets.runs.resize(runBrick.size());
+    std::size_t i = 0;
+    for (const auto& runs : chunkRuns)
+        for (const BrickRun& r : runs)
+            buckets.runs[cursor[runBrick[i++]]++] = r.run;
+    return buckets;
+}
+
+// ---------------------------------------------------------------------------
+// The per-brick accumulator.
+
+/// Channels per voxel: ∫w ds, ∫w u ds (3) and, with the tensor, ∫w u uᵀ ds (6).
+template <bool Tensor>
+constexpr std::size_t kChannels = Tensor ? 10 : 4;
+
+/// The leaves one brick produces.
+struct BrickLeaves {
+    std::vector<std::unique_ptr<FloatLeaf>> density;
+    std::vector<std::unique_ptr<Vec3SLeaf>> orientation, tensorDiag, tensorOffDiag;
+};
+
+/// Dense double sums over one brick and its apron, z fastest (OpenVDB's leaf
+/// order). Coordinates are local: local 0 is voxel (brick origin − 1).
+template <bool Tensor>
+class BrickAccumulator {
+public:
+    static constexpr std::size_t C = kChannels<Tensor>;
+
+    BrickAccumulator() : sums_(std::size_t(kAccDim) * kAccDim * kAccDim * C, 0.0) {}
+
+    /// Adds the segment a + t·d, t ∈ [0, 1] (local index space), of world
+    /// length `length` and unit tangent u, clipped to the cells that touch
+    /// the brick's voxels: local cells [0, 32], i.e. the box [0, 33]³.
+    void addSegment(const IndexSegment& s, double length, const Vec3d& u) {
+        double t0 = 0, t1 = 1;
+        for (int i = 0; i < 3; ++i) {
+            constexpr double lo = 0, hi = kBrickSize + 1;
+            if (s.invD[i] == 0.0) {
+                if (s.a[i] < lo || s.a[i] > hi)
+                    return;
+                continue;
+            }
+            double ta = (lo - s.a[i]) * s.invD[i], tb = (hi - s.a[i]) * s.invD[i];
+            if (ta > tb)
+                std::swap(ta, tb);
+            t0 = std::max(t0, ta);
+            t1 = std::min(t1, tb);
+        }
+        if (!(t0 < t1))
+            return;
+
+        std::array<double, C> channel;
+        channel[0] = 1;
+        channel[1] = u.x;
+        channel[2] = u.y;
+        channel[3] = u.z;
+        if constexpr (Tensor) {
+            channel[4] = u.x * u.x;
+            channel[5] = u.y * u.y;
+            channel[6] = u.z * u.z;
+            channel[7] = u.x * u.y;
+            channel[8] = u.x * u.z;
+            channel[9] = u.y * u.z;
+        }
+
+        const Vec3i cellMin(0), cellMax(kBrickSize);
+        for (int i = 0; i < 3; ++i) {
+            const auto cellAt = [&](double t) {
+                return std::clamp(floorToInt(s.a[i] + t * s.d[i]), 0, kBrickSize);
+            };
+            const int c0 = cellAt(t0), c1 = cellAt(t1);
+            touchedMin_[i] = std::min({touchedMin_[i], c0, c1});
+            touchedMax_[i] = std::max({touchedMax_[i], c0 + 1, c1 + 1});
+        }
+        traverseCells(s, t0, t1, cellMin, cellMax, [&](const Vec3i& cell, double tA, double tB) {
+            splatPiece(s, cell, tA, tB, length * (tB - tA), channel);
+        });
+    }
+
+    /// Emits the leaves of the brick's own voxels (local [1, 32]) that hold
+    /// fiber, and clears what was touched for the next brick.
+    void extract(const openvdb::Coord& brickOrigin, double invVoxelVolume, BrickLeaves& out) {
+        if (touchedMin_.x > touchedMax_.x)
+            return;
+        for (int lx = 0; lx < kLeavesPerBrickSide; ++lx)
+            for (int ly = 0; ly < kLeavesPerBrickSide; ++ly)
+                for (int lz = 0; lz < kLeavesPerBrickSide; ++lz) {
+                    const Vec3i lo = Vec3i(lx, ly, lz) * kLeafDim + 1;
+                    if (glm::any(glm::greaterThan(lo, touchedMax_)) ||
+                        glm::any(glm::lessThan(lo + (kLeafDim - 1), touchedMin_)))
+                        continue;
+                    extractLeaf(lo, brickOrigin + openvdb::Coord(lo.x - 1, lo.y - 1, lo.z - 1),
+                                invVoxelVolume, out);
+                }
+        for (int x = touchedMin_.x; x <= touchedMax_.x; ++x)
+            for (int y = touchedMin_.y; y <= touchedMax_.y; ++y) {
+                double* row = &sums_[index(x, y, touchedMin_.z)];
+                std::fill(row, row + std::size_t(touchedMax_.z - touchedMin_.z + 1) * C, 0.0);
+            }
+        touchedMin_ = Vec3i(kAccDim);
+        touchedMax_ = Vec3i(-1);
+    }
+
+private:
+    static std::size_t index(int x, int y, int z) {
+        return ((std::size_t(x) * kAccDim + std::size_t(y)) * kAccDim + std::size_t(z)) * C;
+    }
+
+    /// Adds ∫ w_v ds · channel to the 8 corners of `cell` for the piece
+    /// t ∈ [tA, tB] of length `pieceLength`, exactly. With τ ∈ [0, 1] along
+    /// the piece, each fraction is linear, f_i(τ) = f_i + δ_i τ, and a
+    /// corner's weight is X·Y·Z with X ∈ {1 − f_x, f_x}, ... For each (Y, Z)
+    /// pair the quadratic YZ has moments Q0 = ∫YZ dτ, Q1 = ∫τ YZ dτ, and then
+    /// ∫ f_x YZ = f_x Q0 + δ_x Q1, ∫ (1 − f_x) YZ = Q0 − ∫ f_x YZ.
+    void splatPiece(const IndexSegment& s, const Vec3i& cell, double tA, double tB,
+                    double pieceLength, const std::array<double, C>& channel) {
+        const Vec3d c(cell);
+        const Vec3d f = glm::clamp(s.at(tA) - c, 0.0, 1.0);
+        const Vec3d delta = glm::clamp(s.at(tB) - c, 0.0, 1.0) - f;
+        // Moments of Y1 = f_y, Z1 = f_z and of their product P = Y1·Z1.
+        constexpr double third = 1.0 / 3.0;
+        const double y0 = f.y + 0.5 * delta.y, y1 = 0.5 * f.y + third * delta.y;
+        const double z0 = f.z + 0.5 * delta.z, z1 = 0.5 * f.z + third * delta.z;
+        const double p0 = f.y * f.z, p1 = f.y * delta.z + delta.y * f.z, p2 = delta.y * delta.z;
+        const double pq0 = p0 + 0.5 * p1 + third * p2, pq1 = 0.5 * p0 + third * p1 + 0.25 * p2;
+        // (Q0, Q1) of the (Y, Z) pairs (0,0), (0,1), (1,0), (1,1).
+        const double q0[4] = {1 - y0 - z0 + pq0, z0 - pq0, y0 - pq0, pq0};
+        const double q1[4] = {0.5 - y1 - z1 + pq1, z1 - pq1, y1 - pq1, pq1};
+        double* base = &sums_[index(cell.x, cell.y, cell.z)];
+        constexpr std::size_t dz = C, dy = std::size_t(kAccDim) * C, dx = dy * kAccDim;
+        constexpr std::size_t yzOffset[4] = {0, dz, dy, dy + dz};
+#pragma GCC unroll 4
+        for (std::size_t k = 0; k < 4; ++k) {
+            const double w1 = f.x * q0[k] + delta.x * q1[k];
+            const double w0 = (q0[k] - w1) * pieceLength;
+            const double w1s = w1 * pieceLength;
+            double* v0 = base + yzOffset[k];
+            double* v1 = v0 + dx;
+#pragma GCC unroll 10
+            for (std::size_t ch = 0; ch < C; ++ch) {
+                v0[ch] += w0 * channel[ch];
+                v1[ch] += w1s * channel[ch];
+            }
+        }
+    }
+
+    void extractLeaf(const Vec3i& lo, const openvdb::Coord& origin, double invVoxelVolume,
+                     BrickLeaves& out) {
+        std::unique_ptr<FloatLeaf> density;
+        std::unique_ptr<Vec3SLeaf> orientation, diag, offDiag;
+        for (int x = 0; x < kLeafDim; ++x)
+            for (int y = 0; y < kLeafDim; ++y)
+                for (int z = 0; z < kLeafDim; ++z) {
+                    const double* v = &sums_[index(lo.x + x, lo.y + y, lo.z + z)];
+                    const auto lambda = static_cast<float>(v[0] * invVoxelVolume);
+                    // Below FLT_MIN λ is physically nothing, and the ratios
+                    // below would lose their precision in denormals.
+                    if (!(lambda >= FLT_MIN))
+                        continue;
+                    if (!density) {
+                        density = std::make_unique<FloatLeaf>(origin, 0.0f, false);
+                        orientation = std::make_unique<Vec3SLeaf>(origin, openvdb::Vec3s(0.0f), false);
+                        if constexpr (Tensor) {
+                            diag = std::make_unique<Vec3SLeaf>(origin, openvdb::Vec3s(0.0f), false);
+                            offDiag = std::make_unique<Vec3SLeaf>(origin, openvdb::Vec3s(0.0f), false);
+                        }
+                    }
+                    const openvdb::Index offset = FloatLeaf::coordToOffset(origin + openvdb::Coord(x, y, z));
+                    const double inv = 1.0 / v[0];
+                    const auto mean = [&](std::size_t ch) {
+                        return openvdb::Vec3s(static_cast<float>(v[ch] * inv),
+                                              static_cast<float>(v[ch + 1] * inv),
+                                              static_cast<float>(v[ch + 2] * inv));
+                    };
+                    density->setValueOn(offset, lambda);
+                    orientation->setValueOn(offset, mean(1));
+                    if constexpr (Tensor) {
+                        diag->setValueOn(offset, mean(4));
+                        offDiag->setValueOn(offset, mean(7));
+                    }
+                }
+        if (!density)
+            return;
+        out.density.push_back(std::move(density));
+        out.orientation.push_back(std::move(orientation));
+        if constexpr (Tensor) {
+            out.tensorDiag.push_back(std::move(diag));
+            out.tensorOffDiag.push_back(std::move(offDiag));
+        }
+    }
+
+    std::vector<double> sums_;
+    Vec3i touchedMin_{kAccDim}, touchedMax_{-1}; ///< corners touched since the last extract
+};
+
+template <bool Tensor>
+std::vector<BrickLeaves> splatBricks(const Groom& groom, const BrickBuckets& buckets, double h,
+                                     bool threaded, ProgressReporter& progress) {
+    const double invH = 1.0 / h, invVoxelVolume = 1.0 / (h * h * h);
+    std::vector<BrickLeaves> leaves(buckets.bricks.size());
+    tbb::enumerable_thread_specific<std::unique_ptr<BrickAccumulator<Tensor>>> accumulators;
+    forEachIndex(buckets.bricks.size(), threaded, [&](std::size_t b) {
+        throwIfInterrupted();
+        auto& acc = accumulators.local();
+        if (!acc)
+            acc = std::make_unique<BrickAccumulator<Tensor>>();
+        const BrickKey& key = buckets.bricks[b];
+        const openvdb::Coord origin(key.x * kBrickSize, key.y * kBrickSize, key.z * kBrickSize);
+        const Vec3d base = Vec3d(origin.x(), origin.y(), origin.z()) - 1.0;
+        for (std::size_t r = buckets.start[b]; r < buckets.start[b + 1]; ++r) {
+            const Run run = buckets.runs[r];
+            // Runs jump around the groom: fetch the next one while this one is splatted.
+            if (r + 1 < buckets.start[b + 1])
+                __builtin_prefetch(&groom.points[buckets.runs[r + 1].begin]);
+            Vec3d p1(groom.points[run.begin]);
+            for (std::uint32_t p = run.begin + 1; p < run.end; ++p) {
+                const Vec3d p0 = p1;
+                p1 = Vec3d(groom.points[p]);
+                const Vec3d delta = p1 - p0;
+                const double length = glm::length(delta);
+                if (length > 0)
+                    acc->addSegment(IndexSegment(p0 * invH - base, delta * invH), length,
+                                    delta * (1.0 / length));
+            }
+        }
+        acc->extract(origin, invVoxelVolume, leaves[b]);
+        progress.update();
+    });
+    return leaves;
+}
+
+// ---------------------------------------------------------------------------
+// Validation and the memory estimate.
+
+/// One parallel pass over the groom: what validation, the default voxel size
+/// and the memory estimate need.
+struct GroomScan {
+    Bounds3f bounds;
+    double totalLength = 0;
+    Vec3d sumAbsDelta{0.0}; ///< Σ over segments of |Δx|, |Δy|, |Δz|
+    std::size_t badStrand = SIZE_MAX, badPoint = 0; ///< first non-finite point
+};
+
+GroomScan scanGroom(const Groom& groom, const std::vector<StrandRange>& chunks, bool threaded) {
+    std::vector<GroomScan> perChunk(chunks.size());
+    forEachIndex(chunks.size(), threaded, [&](std::size_t c) {
+        GroomScan& scan = perChunk[c];
+        for (std::size_t s = chunks[c].begin; s < chunks[c].end && scan.badStrand == SIZE_MAX; ++s) {
+            const auto pts = groom.strand(s);
+            for (std::size_t k = 0; k < pts.size(); ++k) {
+                if (!isFinite(pts[k])) {
+                    scan.badStrand = s;
+                    scan.badPoint = k;
+                    break;
+                }
+                scan.bounds.extend(pts[k]);
+                if (k > 0) {
+                    const Vec3d delta = Vec3d(pts[k]) - Vec3d(pts[k - 1]);
+                    scan.totalLength += glm::length(delta);
+                    scan.sumAbsDelta += glm::abs(delta);
+                }
+            }
+        }
+    });
+    GroomScan total;
+    for (const GroomScan& s : perChunk) {
+        if (s.badStrand != SIZE_MAX)
+            throw InputError(strCat("voxelize: strand ", s.badStrand, ", point ", s.badPoint,
+                                    " has a non-finite coordinate ",
+                                    groom.strand(s.badStrand)[s.badPoint]));
+        total.bounds.extend(s.bounds);
+        total.totalLength += s.totalLength;
+        total.sumAbsDelta += s.sumAbsDelta;
+    }
+    return total;
+}
+
+double voxelSizeFromBounds(const Bounds3f& bounds, int voxelsAcross) {
+    if (voxelsAcross < 1)
+        throw InputError(strCat("voxelize: voxels across = ", voxelsAcross, " should be >= 1"));
+    const Vec3f extent = bounds.extent();
+    const auto longest = static_cast<double>(std::max({extent.x, extent.y, extent.z}));
+    return longest > 0 ? longest / voxelsAcross : 1.0;
+}
+
+struct MemoryEstimate {
+    double leaves = 0, bytes = 0;
+};
+
+/// Leaves: a segment crosses on average Σ|Δ|/(8h) leaf boundaries; each
+/// strand touches about one leaf per crossing plus one, times (9/8)³ for the
+/// trilinear corners that spill into the next leaf, and never more leaves than
+/// the bounding box holds. Bucketing: about one run per strand and brick
+/// crossing, doubled for the bricks above that need a brick's last layer.
+MemoryEstimate estimateMemory(const Groom& groom, const GroomScan& scan, double h, bool tensor,
+                              bool threaded) {
+    double boxLeaves = 1;
+    for (int i = 0; i < 3; ++i) {
+        const double leafSize = h * kLeafDim;
+        boxLeaves *= std::floor(double(scan.bounds.max[i]) / leafSize) -
+                     std::floor(double(scan.bounds.min[i]) / leafSize) + 2;
+    }
+    const double l1 = scan.sumAbsDelta.x + scan.sumAbsDelta.y + scan.sumAbsDelta.z;
+    const auto strands = double(groom.strandCount());
+    constexpr double spill = (9.0 / 8.0) * (9.0 / 8.0) * (9.0 / 8.0);
+    MemoryEstimate e;
+    e.leaves = std::min(boxLeaves, (strands + l1 / (h * kLeafDim)) * spill);
+    const double leafBytes =
+        double(sizeof(FloatLeaf) + FloatLeaf::SIZE * sizeof(float)) +
+        double(tensor ? 3 : 1) * double(sizeof(Vec3SLeaf) + Vec3SLeaf::SIZE * sizeof(openvdb::Vec3s));
+    const double runs = 2.0 * (strands + l1 / (h * kBrickSize));
+    const double accumulatorBytes = double(kAccDim) * kAccDim * kAccDim * (tensor ? 10 : 4) * 8;
+    const double threads = threaded ? std::max(1, activeThreadCount()) : 1;
+    e.bytes = e.leaves * leafBytes + runs * double(sizeof(BrickRun) + sizeof(Run)) +
+              threads * accumulatorBytes;
+    return e;
+}
+
+void validateOptions(const SplatOptions& o) {
+    if (!(std::isfinite(o.voxelSize) && o.voxelSize >= 0))
+        throw InputError(strCat("voxelize: voxel size = ", o.voxelSize,
+                                " should be > 0 (or 0 for the groom's default)"));
+    if (!(std::isfinite(o.fiberDiameter) && o.fiberDiameter > 0))
+        throw InputError(strCat("voxelize: fiber diameter = ", o.fiberDiameter, " should be > 0"));
+    if (!(std::isfinite(o.densityScale) && o.densityScale > 0))
+        throw InputError(strCat("voxelize: density scale = ", o.densityScale, " should be > 0"));
+}
+
+/// Refuses, before anything is allocated, a voxel size that the groom's
+/// coordinates, the float density or the memory budget cannot take.
+void checkVoxelSizeForGroom(const Groom& groom, const GroomScan& scan, double h, double defaultH,
+                            const SplatOptions& options) {
+    const Vec3f lo = glm::abs(scan.bounds.min), hi = glm::abs(scan.bounds.max);
+    const auto reach = static_cast<double>(std::max({lo.x, lo.y, lo.z, hi.x, hi.y, hi.z}));
+    if (reach / h >= kMaxIndex)
+        throw InputError(strCat("voxelize: voxel size ", h, " puts coordinates up to ", reach,
+                                " at voxel index ", reach / h,
+                                ", beyond OpenVDB's 32-bit index space (limit ", kMaxIndex,
+                                "); use a larger voxel size"));
+    // λ ≤ total length / h³ anywhere; it must fit a float.
+    if (!(scan.totalLength / (h * h * h) < double(FLT_MAX)))
+        throw InputError(strCat("voxelize: voxel size ", h,
+                                " is too small: the length density would overflow a float"));
+    const MemoryEstimate memory =
+        estimateMemory(groom, scan, h, options.storeOrientationTensor, options.threaded);
+    if (memory.bytes > double(options.memoryBudgetBytes)) {
+        std::ostringstream os;
+        os << std::setprecision(3) << "voxelize: voxel size " << h << " would need about "
+           << formatGiB(memory.bytes) << " GiB (estimate: " << memory.leaves
+           << " leaf nodes of 8³ voxels), over the memory budget of "
+           << formatGiB(double(options.memoryBudgetBytes))
+           << " GiB; use a larger voxel size (this groom's default is " << defaultH << ")";
+        throw InputError(os.str());
+    }
+}
+
+template <typename GridT>
+typename GridT::Ptr makeGrid(const char* name, double h) {
+    auto grid = GridT::create();
+    grid->setName(name);
+    grid->setTransform(openvdb::math::Transform::createLinearTransform(h));
+    return grid;
+}
+
+template <typename GridT, typename Leaf>
+void addLeaves(GridT& grid, std::vector<std::unique_ptr<Leaf>>& leaves) {
+    for (auto& leaf : leaves)
+        grid.tree().addLeaf(leaf.release());
+}
+
+} // namespace
+
+double defaultVoxelSize(const Groom& groom, int voxelsAcross) {
+    return voxelSizeFromBounds(groom.bounds(), voxelsAcross);
+}
+
+FiberGrid splatStrands(const Groom& groom, const SplatOptions& options) {
+    validateOptions(options);
+    const std::vector<StrandRange> chunks = strandChunks(groom);
+    const GroomScan scan = scanGroom(groom, chunks, options.threaded);
+    const double defaultH = voxelSizeFromBounds(scan.bounds, kDefaultVoxelsAcross);
+    const double h = options.voxelSize > 0 ? options.voxelSize : defaultH;
+    const bool tensor = options.storeOrientationTensor;
+    const bool hasLength = scan.totalLength > 0;
+    if (hasLength)
+        checkVoxelSizeForGroom(groom, scan, h, defaultH, options);
+    // OpenVDB refuses linear transforms whose determinant h³ is below 3e-15.
+    const double minVoxelSize = std::cbrt(3 * openvdb::math::Tolerance<double>::value());
+    if (h < minVoxelSize)
+        throw InputError(strCat("voxelize: voxel size ", h, " is below ", minVoxelSize,
+                                ", the smallest voxel OpenVDB's linear transform allows; "
+                                "express the groom in smaller units"));
+
+    FiberGrid grid;
+    grid.info.voxelSize = h;
+    grid.info.fiberDiameter = options.fiberDiameter;
+    grid.info.densityScale = options.densityScale;
+    grid.info.sourceFile = options.sourceFile;
+    grid.info.sourceHash = hexDigest(contentHash(groom));
+    grid.info.strands = groom.strandCount();
+    grid.info.segments = groom.segmentCount();
+    grid.info.totalLength = scan.totalLength;
+    grid.info.version = HAIRVOX_VERSION;
+    grid.density = makeGrid<openvdb::FloatGrid>(kDensityGridName, h);
+    grid.density->setGridClass(openvdb::GRID_FOG_VOLUME);
+    grid.orientation = makeGrid<openvdb::Vec3SGrid>(kOrientationGridName, h);
+    if (tensor) {
+        grid.tensorDiag = makeGrid<openvdb::Vec3SGrid>(kTensorDiagGridName, h);
+        grid.tensorOffDiag = makeGrid<openvdb::Vec3SGrid>(kTensorOffDiagGridName, h);
+    }
+    if (!hasLength) {
+        grid.warnings.emplace_back(groom.empty()
+                                       ? "the groom is empty; the fiber grid is empty"
+                                       : "the groom has no fiber length; the fiber grid is empty");
+        return grid;
+    }
+
+    const double invH = 1.0 / h;
+    const BrickBuckets buckets = bucketSegments(groom, chunks, invH, options.threaded);
+    ProgressReporter progress("voxelize", buckets.bricks.size(), options.showProgress);
+    std::vector<BrickLeaves> leaves =
+        tensor ? splatBricks<true>(groom, buckets, h, options.threaded, progress)
+               : splatBricks<false>(groom, buckets, h, options.threaded, progress);
+    progress.finish();
+    for (BrickLeaves& b : leaves) {
+        addLeaves(*grid.density, b.density);
+        addLeaves(*grid.orientation, b.orientation);
+        if (tensor) {
+            addLeaves(*grid.tensorDiag, b.tensorDiag);
+            addLeaves(*grid.tensorOffDiag, b.tensorOffDiag);
+        }
+    }
+    return grid;
+}
+
+std::uint64_t FiberGrid::activeVoxelCount() const { return density ? density->activeVoxelCount() : 0; }
+
+std::uint64_t FiberGrid::memoryBytes() const {
+    std::uint64_t bytes = 0;
+    for (const openvdb::GridBase* g : std::initializer_list<const openvdb::GridBase*>{
+             density.get(), orientation.get(), tensorDiag.get(), tensorOffDiag.get()})
+        if (g)
+            bytes += g->memUsage();
+    return bytes;
+}
+
+std::ostream& operator<<(std::ostream& os, const FiberGridInfo& info) {
+    return os << "FiberGridInfo(voxelSize=" << info.voxelSize
+              << ", fiberDiameter=" << info.fiberDiameter << ", densityScale=" << info.densityScale
+              << ", sourceFile=\"" << info.sourceFile << "\", sourceHash=" << info.sourceHash
+              << ", strands=" << info.strands << ", segments=" << info.segments
+              << ", totalLength=" << info.totalLength << ", version=" << info.version << ")";
+}
+
+std::ostream& operator<<(std::ostream& os, const FiberGrid& grid) {
+    return os << "FiberGrid(" << grid.info << ", activeVoxels=" << grid.activeVoxelCount()
+              << ", tensor=" << (grid.hasTensor() ? "yes" : "no") << ")";
+}
+
+std::ostream& operator<<(std::ostream& os, const SplatOptions& o) {
+    return os << "SplatOptions(voxelSize=" << o.voxelSize << ", fiberDiameter=" << o.fiberDiameter
+              << ", densityScale=" << o.densityScale
+              << ", storeOrientationTensor=" << o.storeOrientationTensor
+              << ", threaded=" << o.threaded << ", memoryBudgetBytes=" << o.memoryBudgetBytes
+              << ", sourceFile=\"" << o.sourceFile << "\", showProgress=" << o.showProgress << ")";
+}
+
+} // namespace hairvox
