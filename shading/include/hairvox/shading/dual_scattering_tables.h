@@ -22,7 +22,9 @@
 // closed form (erf). The θ_o integral is split around each lobe's peak
 // (θ_o = 2α_p − θ, width 2β_p) into three Gauss–Legendre pieces. Fibers with
 // eccentricity ≠ 1 are averaged over the cross-section orientation φ_h
-// (uniform), which is the same as averaging over φ_i.
+// (uniform, 8 nodes), which is the same as averaging over φ_i. Measured
+// against order 96: order 8 is off by 3e-2, 16 by 1.5e-4, the default 24 by
+// 5e-5 (ā, Ā_b, N^G); a default build takes ~0.1 s on one core.
 //
 // Numerical traps (DESIGN.md §4): Eqs. 10–12 are geometric series in ā_f²
 // that diverge as ā_f → 1 (σ_a → 0; the model's albedo even exceeds 1 near
