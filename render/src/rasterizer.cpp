@@ -701,6 +701,7 @@ private:
     /// them) and reports them with `where(i)`.
     template <typename Where>
     void shadeBatch(std::size_t count, Where&& where) {
+        throwIfInterrupted(); // an expensive shader (exact mode) makes a tile long
         s_.results.resize(count);
         s_.terms.resize(count * lights_);
         ctx_.shader.shade(std::span(s_.points.data(), count), std::span(s_.results.data(), count),

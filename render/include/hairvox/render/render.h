@@ -78,7 +78,8 @@ struct RenderOutput {
 
 /// Renders `groom` as seen by scene.camera, shaded by `shader` at
 /// scene.shadingRate, with the scene's head and background. Polls
-/// throwIfInterrupted() between tiles. Throws InputError for an invalid scene.
+/// throwIfInterrupted() between tiles and shader batches. Throws InputError
+/// for an invalid scene; segments with non-finite projections are culled.
 RenderOutput renderImage(const Groom& groom, const Scene& scene, const FragmentShader& shader,
                          const RenderOptions& options = {});
 
