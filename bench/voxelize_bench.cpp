@@ -16,6 +16,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <malloc.h>
 #include <map>
 #include <string>
 
@@ -46,8 +47,10 @@ double statusKiB(const std::string& field) {
     return 0;
 }
 
-/// Resets the peak-RSS counter VmHWM to the current RSS (Linux ≥ 4.0).
+/// Returns freed heap to the system, then resets the peak-RSS counter VmHWM to
+/// the current RSS (Linux ≥ 4.0), so that the next peak is this splat's own.
 void resetPeakRss() {
+    ::malloc_trim(0);
     std::ofstream clear("/proc/self/clear_refs");
     clear << "5";
 }
@@ -82,9 +85,15 @@ void splat(benchmark::State& state, bool tensor, int threads) {
     state.counters["threads"] = activeThreadCount();
 }
 
-void BM_SplatWavy(benchmark::State& state) { splat(state, false, 0); }
-void BM_SplatWavyOneThread(benchmark::State& state) { splat(state, false, 1); }
-void BM_SplatWavyTensor(benchmark::State& state) { splat(state, true, 0); }
+void BM_SplatWavy(benchmark::State& state) {
+    splat(state, false, 0);
+}
+void BM_SplatWavyOneThread(benchmark::State& state) {
+    splat(state, false, 1);
+}
+void BM_SplatWavyTensor(benchmark::State& state) {
+    splat(state, true, 0);
+}
 
 // 358, 3,572, 17,858 and 50,000 strands of 28 segments: 10k, 100k, 500k, 1.4M segments.
 BENCHMARK(BM_SplatWavy)
@@ -94,7 +103,11 @@ BENCHMARK(BM_SplatWavy)
     ->Arg(50000)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
-BENCHMARK(BM_SplatWavyOneThread)->Arg(3572)->Arg(50000)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_SplatWavyOneThread)
+    ->Arg(3572)
+    ->Arg(50000)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK(BM_SplatWavyTensor)->Arg(50000)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 } // namespace

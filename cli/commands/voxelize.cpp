@@ -43,8 +43,8 @@ void runVoxelize(const VoxelizeOptions& opt) {
         std::fprintf(stderr, "hairvox: warning: %s: %s\n", opt.input.c_str(), w.c_str());
 
     SplatOptions splat;
-    splat.voxelSize = opt.voxelSize > 0 ? opt.voxelSize
-                                        : defaultVoxelSize(loaded.groom, opt.voxelsAcross);
+    splat.voxelSize =
+        opt.voxelSize > 0 ? opt.voxelSize : defaultVoxelSize(loaded.groom, opt.voxelsAcross);
     splat.fiberDiameter = opt.diameter;
     splat.densityScale = opt.densityScale;
     splat.storeOrientationTensor = opt.tensor;

@@ -4,9 +4,8 @@
 #include <hairvox/core/error.h>
 #include <hairvox/strands/procedural.h>
 
-#include <openvdb/io/File.h>
-
 #include <gtest/gtest.h>
+#include <openvdb/io/File.h>
 
 #include <cstdio>
 #include <cstdlib>

@@ -2,12 +2,12 @@
 
 #include <hairvox/core/error.h>
 #include <hairvox/core/hash.h>
+#include <hairvox/core/interrupt.h>
 #include <hairvox/core/rng.h>
 #include <hairvox/strands/procedural.h>
 
-#include <openvdb/tools/Interpolation.h>
-
 #include <gtest/gtest.h>
+#include <openvdb/tools/Interpolation.h>
 
 #include <cmath>
 #include <vector>
@@ -31,7 +31,9 @@ SplatOptions withVoxelSize(double h, bool tensor = false) {
     return o;
 }
 
-float density(const FiberGrid& g, const Coord& c) { return g.density->tree().getValue(c); }
+float density(const FiberGrid& g, const Coord& c) {
+    return g.density->tree().getValue(c);
+}
 openvdb::Vec3s orientation(const FiberGrid& g, const Coord& c) {
     return g.orientation->tree().getValue(c);
 }
@@ -120,8 +122,8 @@ TEST(Splat, TrilinearSamplingIsTheVertexCentredReconstruction) {
     // Voxel ijk is the value at world ijk·h: OpenVDB's BoxSampler through the
     // grid's transform returns it there, and interpolates between voxels.
     const double h = 0.37;
-    const FiberGrid g = splatStrands(groomOf({{{0.1f, 0.2f, 0.3f}, {2.9f, 1.7f, 0.8f}}}),
-                                     withVoxelSize(h));
+    const FiberGrid g =
+        splatStrands(groomOf({{{0.1f, 0.2f, 0.3f}, {2.9f, 1.7f, 0.8f}}}), withVoxelSize(h));
     openvdb::tools::GridSampler<openvdb::FloatGrid, openvdb::tools::BoxSampler> sampler(*g.density);
     // BoxSampler interpolates in float: compare relative to the largest value.
     const double tol = 1e-6 / (h * h);
@@ -140,9 +142,12 @@ TEST(Splat, TrilinearSamplingIsTheVertexCentredReconstruction) {
 // Orientation and its second moment.
 
 TEST(Splat, SingleFiberOrientationIsItsDirection) {
-    const std::vector<Vec3d> directions = {
-        {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {-1, 0, 0}, glm::normalize(Vec3d(1, 1, 1)),
-        glm::normalize(Vec3d(-0.3, 0.8, -0.52))};
+    const std::vector<Vec3d> directions = {{1, 0, 0},
+                                           {0, 1, 0},
+                                           {0, 0, 1},
+                                           {-1, 0, 0},
+                                           glm::normalize(Vec3d(1, 1, 1)),
+                                           glm::normalize(Vec3d(-0.3, 0.8, -0.52))};
     for (const Vec3d& u : directions) {
         const Vec3f start(0.13f, -0.21f, 0.34f);
         const Vec3f end = start + Vec3f(2.7 * u);
@@ -210,6 +215,40 @@ TEST(Splat, StatisticsOfRealGroomsAreBounded) {
     }
 }
 
+TEST(Splat, NearlyLatticeAlignedFibersKeepBoundedStatistics) {
+    // Fibers a hair's breadth from voxel planes give their far corners
+    // rounding-sized weights; the orientation of such voxels must not be a
+    // ratio of rounding errors.
+    Pcg32 rng(7);
+    constexpr double h = 0.25;
+    Groom groom;
+    for (int s = 0; s < 200; ++s) {
+        // A lattice coordinate, or one float step beside it.
+        const auto coordinate = [&] {
+            const auto x = float(h * double(rng.nextU32() % 9));
+            const std::uint32_t side = rng.nextU32() % 3;
+            return side == 0 ? x : std::nextafter(x, side == 1 ? 1e9f : -1e9f);
+        };
+        const auto nearLattice = [&] {
+            return Vec3f(coordinate(), coordinate(), coordinate());
+        };
+        const Vec3f a = nearLattice(), b = nearLattice();
+        if (a != b)
+            groom.addStrand(std::vector<Vec3f>{a, b});
+    }
+    const FiberGrid g = splatStrands(groom, withVoxelSize(h, true));
+    EXPECT_NEAR(test::splattedLength(g) / test::exactLength(groom), 1.0, 1e-5);
+    for (auto it = g.density->cbeginValueOn(); it; ++it) {
+        const Coord c = it.getCoord();
+        ASSERT_LE(orientation(g, c).length(), 1 + 1e-5) << c << ", λ = " << *it;
+        const openvdb::Vec3s diag = g.tensorDiag->tree().getValue(c);
+        ASSERT_NEAR(diag.x() + diag.y() + diag.z(), 1.0, 1e-5) << c << ", λ = " << *it;
+        ASSERT_GE(diag.x(), -1e-5f) << c;
+        ASSERT_GE(diag.y(), -1e-5f) << c;
+        ASSERT_GE(diag.z(), -1e-5f) << c;
+    }
+}
+
 // ---------------------------------------------------------------------------
 // Length conservation.
 
@@ -218,7 +257,8 @@ Groom randomGroom(std::uint64_t seed, const Vec3f& offset) {
     Pcg32 rng(seed);
     Groom g;
     for (int s = 0; s < 20; ++s) {
-        std::vector<Vec3f> pts{offset + Vec3f(rng.uniform(-2, 2), rng.uniform(-2, 2), rng.uniform(-2, 2))};
+        std::vector<Vec3f> pts{offset +
+                               Vec3f(rng.uniform(-2, 2), rng.uniform(-2, 2), rng.uniform(-2, 2))};
         const int n = 2 + static_cast<int>(rng.nextU32() % 11);
         for (int k = 1; k < n; ++k) {
             const float cosTheta = rng.uniform(-1, 1), phi = rng.uniform(0, 6.2831853f);
@@ -250,18 +290,18 @@ TEST(Splat, ConservesLengthOnVoxelBoundaries) {
     // planes, lines and vertices, and on the planes between 32³ bricks (16).
     constexpr double h = 0.5;
     const std::vector<std::vector<Vec3f>> cases = {
-        {{0, 0, 0}, {2, 0, 0}},                   // along a line of voxels
-        {{0.2f, 0.5f, 0.1f}, {1.7f, 0.5f, 1.3f}}, // in a voxel plane
-        {{0, 0, 0}, {2, 2, 2}},                   // through voxel vertices
-        {{-1.5f, -1, -0.5f}, {1.5f, 1, 0.5f}},    // through vertices, across 0
-        {{0.1f, 0.1f, 0.1f}, {0.2f, 0.15f, 0.12f}}, // inside one cell
-        {{0, 0, 0}, {0.5f, 0, 0}},                // one cell edge exactly
-        {{0.5f, 0.1f, 0.2f}, {1.0f, 0.3f, 0.4f}}, // face to face
+        {{0, 0, 0}, {2, 0, 0}},                         // along a line of voxels
+        {{0.2f, 0.5f, 0.1f}, {1.7f, 0.5f, 1.3f}},       // in a voxel plane
+        {{0, 0, 0}, {2, 2, 2}},                         // through voxel vertices
+        {{-1.5f, -1, -0.5f}, {1.5f, 1, 0.5f}},          // through vertices, across 0
+        {{0.1f, 0.1f, 0.1f}, {0.2f, 0.15f, 0.12f}},     // inside one cell
+        {{0, 0, 0}, {0.5f, 0, 0}},                      // one cell edge exactly
+        {{0.5f, 0.1f, 0.2f}, {1.0f, 0.3f, 0.4f}},       // face to face
         {{0.3f, 0.3f, 0.3f}, {0.3f, 0.3f, 0.3000001f}}, // very short
-        {{16, 0.3f, 0.2f}, {16, 5, 3}},           // in a brick boundary plane
-        {{16, 16, -3}, {16, 16, 3}},              // along a brick edge
+        {{16, 0.3f, 0.2f}, {16, 5, 3}},                 // in a brick boundary plane
+        {{16, 16, -3}, {16, 16, 3}},                    // along a brick edge
         {{15.9f, 15.9f, 15.9f}, {16.1f, 16.1f, 16.1f}}, // through a brick corner
-        {{-16, -16, -16}, {40, 33, 20}},          // across several bricks
+        {{-16, -16, -16}, {40, 33, 20}},                // across several bricks
     };
     for (const auto& c : cases) {
         const Groom groom = groomOf({c});
@@ -329,7 +369,8 @@ TEST(Splat, RecordsWhatTheGridWasMadeFrom) {
     EXPECT_EQ(g.density->getName(), "density");
     EXPECT_EQ(g.orientation->getName(), "orientation");
     EXPECT_EQ(g.density->getGridClass(), openvdb::GRID_FOG_VOLUME);
-    EXPECT_EQ(g.density->transform(), *openvdb::math::Transform::createLinearTransform(g.info.voxelSize));
+    EXPECT_EQ(g.density->transform(),
+              *openvdb::math::Transform::createLinearTransform(g.info.voxelSize));
 }
 
 TEST(Splat, DefaultVoxelSizeIsTheLongestSideOverAFixedCount) {
@@ -396,6 +437,16 @@ TEST(Splat, RefusesVoxelsBelowOpenVdbsSmallestTransform) {
     EXPECT_THROW(splatStrands(tiny, withVoxelSize(1e-6)), InputError);
     EXPECT_THROW(splatStrands(Groom{}, withVoxelSize(1e-6)), InputError);
     EXPECT_NO_THROW(splatStrands(tiny, withVoxelSize(2e-5)));
+}
+
+TEST(Splat, StopsWhenInterrupted) {
+    ProceduralGroomParams p;
+    p.strands = 500;
+    const Groom groom = generateGroom(p);
+    requestInterrupt();
+    EXPECT_THROW(splatStrands(groom, SplatOptions{}), Interrupted);
+    clearInterrupt();
+    EXPECT_NO_THROW(splatStrands(groom, SplatOptions{}));
 }
 
 TEST(Splat, RefusesNonFinitePoints) {

@@ -18,7 +18,9 @@ std::filesystem::path writeGroom(const test::TempDir& dir) {
     return path;
 }
 
-std::string quoted(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
+std::string quoted(const std::filesystem::path& p) {
+    return "'" + p.string() + "'";
+}
 
 TEST(VoxelizeCli, WritesAGridAndReportsIt) {
     test::TempDir dir;
@@ -43,9 +45,8 @@ TEST(VoxelizeCli, WritesAGridAndReportsIt) {
 TEST(VoxelizeCli, ExplicitVoxelSize) {
     test::TempDir dir;
     const auto hair = writeGroom(dir);
-    const auto r =
-        test::runHairvox("voxelize " + quoted(hair) + " -o " + quoted(dir / "g.vdb") +
-                         " --voxel-size 0.004");
+    const auto r = test::runHairvox("voxelize " + quoted(hair) + " -o " + quoted(dir / "g.vdb") +
+                                    " --voxel-size 0.004");
     ASSERT_EQ(r.exitCode, 0) << r.output;
     EXPECT_EQ(readFiberGrid(dir / "g.vdb").info.voxelSize, 0.004);
 }
@@ -80,8 +81,8 @@ TEST(VoxelizeCli, AbsurdVoxelSizeIsRefusedWithTheEstimate) {
 TEST(VoxelizeCli, EmptyGroomWarnsAndWritesAnEmptyGrid) {
     test::TempDir dir;
     writeHairFile(dir / "empty.hair", Groom{});
-    const auto r = test::runHairvox("voxelize " + quoted(dir / "empty.hair") + " -o " +
-                                    quoted(dir / "g.vdb"));
+    const auto r =
+        test::runHairvox("voxelize " + quoted(dir / "empty.hair") + " -o " + quoted(dir / "g.vdb"));
     ASSERT_EQ(r.exitCode, 0) << r.output;
     EXPECT_NE(r.output.find("warning"), std::string::npos) << r.output;
     EXPECT_EQ(readFiberGrid(dir / "g.vdb").activeVoxelCount(), 0u);

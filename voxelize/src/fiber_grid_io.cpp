@@ -34,7 +34,8 @@ void addMetadata(openvdb::GridBase& grid, const FiberGridInfo& info) {
     grid.insertMeta(kMetaSourceFile, openvdb::StringMetadata(info.sourceFile));
     grid.insertMeta(kMetaSourceHash, openvdb::StringMetadata(info.sourceHash));
     grid.insertMeta(kMetaStrands, openvdb::Int64Metadata(static_cast<std::int64_t>(info.strands)));
-    grid.insertMeta(kMetaSegments, openvdb::Int64Metadata(static_cast<std::int64_t>(info.segments)));
+    grid.insertMeta(kMetaSegments,
+                    openvdb::Int64Metadata(static_cast<std::int64_t>(info.segments)));
     grid.insertMeta(kMetaTotalLength, openvdb::DoubleMetadata(info.totalLength));
     grid.insertMeta(kMetaVersion, openvdb::StringMetadata(info.version));
 }
@@ -89,8 +90,7 @@ typename GridT::Ptr readGrid(openvdb::io::File& in, const char* name, const std:
         return nullptr;
     auto grid = openvdb::gridPtrCast<GridT>(in.readGrid(name));
     if (!grid)
-        throw InputError(strCat(file, ": grid '", name, "' should be of type ",
-                                GridT::gridType()));
+        throw InputError(strCat(file, ": grid '", name, "' should be of type ", GridT::gridType()));
     return grid;
 }
 
@@ -120,7 +120,8 @@ bool finiteVec(const openvdb::Vec3s& v) {
 
 void writeFiberGrid(const std::filesystem::path& path, const FiberGrid& grid) {
     if (!grid.density || !grid.orientation)
-        throw std::invalid_argument("writeFiberGrid: the density and orientation grids are required");
+        throw std::invalid_argument(
+            "writeFiberGrid: the density and orientation grids are required");
     openvdb::initialize();
     // Shallow copies (shared trees) carry the metadata, leaving the caller's grids untouched.
     openvdb::GridPtrVec grids;
@@ -161,7 +162,8 @@ FiberGrid readFiberGrid(const std::filesystem::path& path) {
                                     "' and '", kOrientationGridName, "'"));
         if ((grid.tensorDiag == nullptr) != (grid.tensorOffDiag == nullptr))
             throw InputError(strCat(file, ": the grids '", kTensorDiagGridName, "' and '",
-                                    kTensorOffDiagGridName, "' come together; only one is present"));
+                                    kTensorOffDiagGridName,
+                                    "' come together; only one is present"));
         grid.info = readMetadata(*grid.density, file);
 
         const double h = grid.info.voxelSize;

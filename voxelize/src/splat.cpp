@@ -1,18 +1,18 @@
 // hairvox voxelize: splatting strands into the fiber grid (conventions in fiber_grid.h).
 //
-// The work is organised so that every voxel's value is a sum over the
-// segments in groom order, whatever the number of threads:
-//  1. Scan: validate the groom, total its length, estimate the memory and
-//     refuse a voxel size over the budget before anything big is allocated.
-//  2. Bucket: fixed chunks of strands (boundaries depend on the groom only)
-//     list in parallel, per segment, the bricks (32³-voxel blocks) whose
-//     voxels it can reach; a serial counting sort in chunk order then gives
-//     each brick its segments in groom order.
-//  3. Splat: bricks in parallel. A brick owns its 32³ voxels and computes them
-//     alone, from every cell that touches them (its own cells and a one-cell
-//     apron below it, which a neighbour also visits for its own voxels), into
-//     a dense double accumulator of one thread; then it emits OpenVDB leaves.
-//     No voxel is written by two bricks, so there is no merge step.
+// The work is organised so that every voxel's value is a sum in an order
+// fixed by the groom alone, whatever the number of threads:
+//  1. Scan (parallel over fixed chunks of strands): validate the points, the
+//     bounds and the total length; estimate the memory and refuse a voxel
+//     size over the budget before anything big is allocated.
+//  2. Bucket (parallel over the same chunks): cut each strand into runs of
+//     consecutive segments that reach one brick (a 32³-voxel block); a
+//     serial counting sort in chunk order gives every brick its runs.
+//  3. Splat (parallel over bricks, largest first): a brick owns its 32³
+//     voxels and computes them alone, from every cell that touches them (its
+//     own cells and a one-cell apron below, which a neighbour also visits
+//     for its own voxels), in a dense double accumulator of the thread, then
+//     emits OpenVDB leaves. No voxel is written by two bricks: no merge step.
 //  4. The leaves are added to the trees serially (cheap: one per 512 voxels).
 #include <hairvox/core/error.h>
 #include <hairvox/core/hash.h>
@@ -24,14 +24,19 @@
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cfloat>
 #include <cmath>
+#include <cstring>
 #include <iomanip>
 #include <limits>
 #include <memory>
+#include <numeric>
 #include <sstream>
 #include <unordered_map>
 
@@ -46,11 +51,16 @@ namespace {
 using FloatLeaf = openvdb::FloatTree::LeafNodeType;
 using Vec3SLeaf = openvdb::Vec3STree::LeafNodeType;
 using Vec3i = glm::ivec3;
+/// Two doubles in one SIMD register (GCC/Clang vector extension; plain
+/// scalar code on targets without SIMD). The accumulator's channels are
+/// updated in pairs: the hot loop is otherwise compiled to scalar code.
+using Double2 = double __attribute__((vector_size(2 * sizeof(double))));
 
 constexpr int kLeafDim = static_cast<int>(FloatLeaf::DIM); // 8
-/// Brick side in voxels: a multiple of the leaf size. 32 keeps the segments
-/// that reach two bricks rare (a default-size segment spans ~5 voxels) while
-/// one accumulator (34³ voxels × 4 doubles = 1.2 MiB) stays cache-friendly.
+/// Brick side in voxels, a multiple of the leaf size. Measured on the 1.4M
+/// segment wavy groom: 16 gives 2.4M (segment, brick) clips for 1.4M
+/// segments and a slower bucketing, 32 gives 1.8M at the same splat speed,
+/// with one accumulator of 34³ voxels × 4 doubles = 1.2 MiB per thread.
 constexpr int kBrickLog2 = 5;
 constexpr int kBrickSize = 1 << kBrickLog2;
 constexpr int kLeavesPerBrickSide = kBrickSize / kLeafDim;
@@ -63,7 +73,9 @@ constexpr std::size_t kChunkSegments = 16384;
 /// Coordinates must stay well inside OpenVDB's int32 index space.
 constexpr double kMaxIndex = 1 << 30;
 
-double formatGiB(double bytes) { return bytes / double(1ull << 30); }
+double formatGiB(double bytes) {
+    return bytes / double(1ull << 30);
+}
 
 // ---------------------------------------------------------------------------
 // Running work in fixed chunks, in parallel or on the calling thread.
@@ -80,6 +92,23 @@ void forEachIndex(std::size_t n, bool threaded, const F& f) {
                           for (std::size_t i = r.begin(); i != r.end(); ++i)
                               f(i);
                       });
+}
+
+/// f(0), f(1), ... f(n − 1), started in this order (on the calling thread,
+/// or by all of TBB's threads taking the next index as they free up).
+template <typename F>
+void forEachIndexInOrder(std::size_t n, bool threaded, const F& f) {
+    if (!threaded) {
+        for (std::size_t i = 0; i < n; ++i)
+            f(i);
+        return;
+    }
+    std::atomic<std::size_t> next{0};
+    tbb::parallel_for(0, tbb::this_task_arena::max_concurrency(), [&](int) {
+        // Stop taking work once another thread threw (e.g. Interrupted).
+        for (std::size_t i = next++; i < n && !tbb::is_current_task_group_canceling(); i = next++)
+            f(i);
+    });
 }
 
 struct StrandRange {
@@ -116,14 +145,18 @@ int floorToInt(double x) {
     return x < i ? i - 1 : i;
 }
 
-Vec3i floorToInt(const Vec3d& v) { return {floorToInt(v.x), floorToInt(v.y), floorToInt(v.z)}; }
+Vec3i floorToInt(const Vec3d& v) {
+    return {floorToInt(v.x), floorToInt(v.y), floorToInt(v.z)};
+}
 
 /// The segment a + t·d, t ∈ [0, 1], in index space, with 1/d per axis (0 on
 /// an axis the segment does not advance along, or too little for 1/d).
 struct IndexSegment {
     Vec3d a, d, invD;
 
-    IndexSegment(const Vec3d& start, const Vec3d& delta) : a(start), d(delta) {
+    IndexSegment(const Vec3d& start, const Vec3d& delta)
+        : a(start)
+        , d(delta) {
         for (int i = 0; i < 3; ++i) {
             const double inv = 1.0 / d[i];
             invD[i] = std::isfinite(inv) ? inv : 0.0;
@@ -214,19 +247,20 @@ void bricksOfSegment(const Vec3d& a, const Vec3d& b, std::vector<BrickKey>& out)
     constexpr double invBrick = 1.0 / kBrickSize;
     constexpr int big = std::numeric_limits<int>::max() / 2;
     const IndexSegment inBricks(a * invBrick, (b - a) * invBrick);
-    traverseCells(inBricks, 0.0, 1.0, Vec3i(-big), Vec3i(big), [&](const Vec3i& brick, double tA, double tB) {
-        // Does the piece reach the brick's last cell layer on each axis? (Voxel
-        // units; the margin keeps the test conservative against rounding.)
-        Vec3i up(0);
-        for (int i = 0; i < 3; ++i) {
-            const double hi = std::max(a[i] + tA * (b[i] - a[i]), a[i] + tB * (b[i] - a[i]));
-            up[i] = hi >= double(brick[i] * kBrickSize + kBrickSize - 1) - 1e-6 ? 1 : 0;
-        }
-        for (int ex = 0; ex <= up.x; ++ex)
-            for (int ey = 0; ey <= up.y; ++ey)
-                for (int ez = 0; ez <= up.z; ++ez)
-                    add({brick.x + ex, brick.y + ey, brick.z + ez});
-    });
+    traverseCells(
+        inBricks, 0.0, 1.0, Vec3i(-big), Vec3i(big), [&](const Vec3i& brick, double tA, double tB) {
+            // Does the piece reach the brick's last cell layer on each axis? (Voxel
+            // units; the margin keeps the test conservative against rounding.)
+            Vec3i up(0);
+            for (int i = 0; i < 3; ++i) {
+                const double hi = std::max(a[i] + tA * (b[i] - a[i]), a[i] + tB * (b[i] - a[i]));
+                up[i] = hi >= double(brick[i] * kBrickSize + kBrickSize - 1) - 1e-6 ? 1 : 0;
+            }
+            for (int ex = 0; ex <= up.x; ++ex)
+                for (int ey = 0; ey <= up.y; ++ey)
+                    for (int ez = 0; ez <= up.z; ++ez)
+                        add({brick.x + ex, brick.y + ey, brick.z + ez});
+        });
 }
 
 /// Consecutive segments of one strand that all reach one brick: points
@@ -237,14 +271,25 @@ struct Run {
     std::uint32_t begin = 0, end = 0;
 };
 
-struct BrickRun {
-    BrickKey brick;
-    Run run;
+/// The runs of one chunk's strands, in a fixed order; bricks are numbered
+/// locally, in order of first appearance.
+struct ChunkRuns {
+    struct Entry {
+        std::uint32_t brick; ///< index into bricks
+        Run run;
+    };
+    std::vector<BrickKey> bricks;
+    std::vector<Entry> runs;
 };
 
-/// The runs of the strands of one chunk, in a fixed order.
-void runsOfChunk(const Groom& groom, const StrandRange& chunk, double invH,
-                 std::vector<BrickRun>& runs) {
+void runsOfChunk(const Groom& groom, const StrandRange& chunk, double invH, ChunkRuns& out) {
+    std::unordered_map<BrickKey, std::uint32_t, BrickKeyHash> localIds;
+    const auto localId = [&](const BrickKey& key) {
+        const auto [it, inserted] = localIds.try_emplace(key, std::uint32_t(out.bricks.size()));
+        if (inserted)
+            out.bricks.push_back(key);
+        return it->second;
+    };
     struct Open {
         BrickKey brick;
         std::uint32_t begin;
@@ -265,15 +310,16 @@ void runsOfChunk(const Groom& groom, const StrandRange& chunk, double invH,
                 if (std::find(keys.begin(), keys.end(), o.brick) != keys.end())
                     stillOpen.push_back(o);
                 else
-                    runs.push_back({o.brick, {o.begin, p + 1}});
+                    out.runs.push_back({localId(o.brick), {o.begin, p + 1}});
             }
             for (const BrickKey& k : keys)
-                if (std::none_of(open.begin(), open.end(), [&](const Open& o) { return o.brick == k; }))
+                if (std::none_of(open.begin(), open.end(),
+                                 [&](const Open& o) { return o.brick == k; }))
                     stillOpen.push_back({k, p});
             std::swap(open, stillOpen);
         }
         for (const Open& o : open)
-            runs.push_back({o.brick, {o.begin, last + 1}});
+            out.runs.push_back({localId(o.brick), {o.begin, last + 1}});
         open.clear();
     }
 }
@@ -283,40 +329,52 @@ struct BrickBuckets {
     std::vector<BrickKey> bricks;
     std::vector<std::size_t> start; ///< runs of brick b: [start[b], start[b + 1])
     std::vector<Run> runs;
+    /// Brick ids by decreasing number of segments: the order in which they are
+    /// started, so that the longest do not end up last on one thread (load
+    /// balance only; every brick's result is independent of it).
+    std::vector<std::uint32_t> largestFirst;
 };
 
-BrickBuckets bucketSegments(const Groom& groom, const std::vector<StrandRange>& chunks,
-                            double invH, bool threaded) {
-    std::vector<std::vector<BrickRun>> chunkRuns(chunks.size());
+BrickBuckets bucketSegments(const Groom& groom, const std::vector<StrandRange>& chunks, double invH,
+                            bool threaded) {
+    std::vector<ChunkRuns> chunkRuns(chunks.size());
     forEachIndex(chunks.size(), threaded, [&](std::size_t c) {
         throwIfInterrupted();
         runsOfChunk(groom, chunks[c], invH, chunkRuns[c]);
     });
 
-    // Counting sort in chunk order; brick ids in order of first appearance.
+    // Global brick ids in order of first appearance, chunk by chunk.
     BrickBuckets buckets;
     std::unordered_map<BrickKey, std::uint32_t, BrickKeyHash> ids;
-    std::vector<std::uint32_t> runBrick;
-    std::vector<std::size_t> counts;
-    for (const auto& runs : chunkRuns)
-        for (const BrickRun& r : runs) {
-            const auto [it, inserted] = ids.try_emplace(r.brick, std::uint32_t(buckets.bricks.size()));
-            if (inserted) {
-                buckets.bricks.push_back(r.brick);
-                counts.push_back(0);
-            }
-            ++counts[it->second];
-            runBrick.push_back(it->second);
+    std::vector<std::vector<std::uint32_t>> globalId(chunks.size());
+    for (std::size_t c = 0; c < chunks.size(); ++c)
+        for (const BrickKey& key : chunkRuns[c].bricks) {
+            const auto [it, inserted] = ids.try_emplace(key, std::uint32_t(buckets.bricks.size()));
+            if (inserted)
+                buckets.bricks.push_back(key);
+            globalId[c].push_back(it->second);
+        }
+    // Counting sort of the runs by brick, in chunk order.
+    std::vector<std::size_t> counts(buckets.bricks.size(), 0), segments(buckets.bricks.size(), 0);
+    for (std::size_t c = 0; c < chunks.size(); ++c)
+        for (const ChunkRuns::Entry& e : chunkRuns[c].runs) {
+            const std::uint32_t b = globalId[c][e.brick];
+            ++counts[b];
+            segments[b] += e.run.end - e.run.begin - 1;
         }
     buckets.start.assign(buckets.bricks.size() + 1, 0);
     for (std::size_t b = 0; b < counts.size(); ++b)
         buckets.start[b + 1] = buckets.start[b] + counts[b];
     std::vector<std::size_t> cursor(buckets.start.begin(), buckets.start.end() - 1);
-    buckets.runs.resize(runBrick.size());
-    std::size_t i = 0;
-    for (const auto& runs : chunkRuns)
-        for (const BrickRun& r : runs)
-            buckets.runs[cursor[runBrick[i++]]++] = r.run;
+    buckets.runs.resize(buckets.start.back());
+    for (std::size_t c = 0; c < chunks.size(); ++c)
+        for (const ChunkRuns::Entry& e : chunkRuns[c].runs)
+            buckets.runs[cursor[globalId[c][e.brick]]++] = e.run;
+
+    buckets.largestFirst.resize(buckets.bricks.size());
+    std::iota(buckets.largestFirst.begin(), buckets.largestFirst.end(), 0u);
+    std::stable_sort(buckets.largestFirst.begin(), buckets.largestFirst.end(),
+                     [&](std::uint32_t a, std::uint32_t b) { return segments[a] > segments[b]; });
     return buckets;
 }
 
@@ -326,6 +384,25 @@ BrickBuckets bucketSegments(const Groom& groom, const std::vector<StrandRange>& 
 /// Channels per voxel: ∫w ds, ∫w u ds (3) and, with the tensor, ∫w u uᵀ ds (6).
 template <bool Tensor>
 constexpr std::size_t kChannels = Tensor ? 10 : 4;
+
+/// The per-segment values splatted with the weights: 1, u and (with the tensor) u uᵀ.
+template <std::size_t C>
+std::array<double, C> channelValues(const Vec3d& u) {
+    std::array<double, C> v;
+    v[0] = 1;
+    v[1] = u.x;
+    v[2] = u.y;
+    v[3] = u.z;
+    if constexpr (C == 10) {
+        v[4] = u.x * u.x;
+        v[5] = u.y * u.y;
+        v[6] = u.z * u.z;
+        v[7] = u.x * u.y;
+        v[8] = u.x * u.z;
+        v[9] = u.y * u.z;
+    }
+    return v;
+}
 
 /// The leaves one brick produces.
 struct BrickLeaves {
@@ -339,12 +416,16 @@ template <bool Tensor>
 class BrickAccumulator {
 public:
     static constexpr std::size_t C = kChannels<Tensor>;
+    static_assert(C % 2 == 0, "channels are updated in pairs");
+    static_assert(kLeavesPerBrickSide * kLeavesPerBrickSide * kLeavesPerBrickSide <= 64,
+                  "touchedLeaves_ has one bit per leaf");
 
-    BrickAccumulator() : sums_(std::size_t(kAccDim) * kAccDim * kAccDim * C, 0.0) {}
+    BrickAccumulator()
+        : sums_(std::size_t(kAccDim) * kAccDim * kAccDim * C, 0.0) {}
 
-    /// Adds the segment a + t·d, t ∈ [0, 1] (local index space), of world
-    /// length `length` and unit tangent u, clipped to the cells that touch
-    /// the brick's voxels: local cells [0, 32], i.e. the box [0, 33]³.
+    /// Adds segment s (in local index space) of world length `length` and
+    /// unit tangent u, clipped to the cells that touch the brick's voxels:
+    /// local cells [0, 32], i.e. the box [0, 33]³.
     void addSegment(const IndexSegment& s, double length, const Vec3d& u) {
         double t0 = 0, t1 = 1;
         for (int i = 0; i < 3; ++i) {
@@ -363,56 +444,60 @@ public:
         if (!(t0 < t1))
             return;
 
-        std::array<double, C> channel;
-        channel[0] = 1;
-        channel[1] = u.x;
-        channel[2] = u.y;
-        channel[3] = u.z;
-        if constexpr (Tensor) {
-            channel[4] = u.x * u.x;
-            channel[5] = u.y * u.y;
-            channel[6] = u.z * u.z;
-            channel[7] = u.x * u.y;
-            channel[8] = u.x * u.z;
-            channel[9] = u.y * u.z;
-        }
+        const std::array<double, C> values = channelValues<C>(u);
+        std::array<Double2, C / 2> channel;
+        for (std::size_t j = 0; j < C / 2; ++j)
+            channel[j] = Double2{values[2 * j], values[2 * j + 1]};
 
         const Vec3i cellMin(0), cellMax(kBrickSize);
+        // Mark the leaves whose voxels the segment's box of cell corners reaches.
+        Vec3i leafLo, leafHi;
         for (int i = 0; i < 3; ++i) {
             const auto cellAt = [&](double t) {
                 return std::clamp(floorToInt(s.a[i] + t * s.d[i]), 0, kBrickSize);
             };
             const int c0 = cellAt(t0), c1 = cellAt(t1);
-            touchedMin_[i] = std::min({touchedMin_[i], c0, c1});
-            touchedMax_[i] = std::max({touchedMax_[i], c0 + 1, c1 + 1});
+            leafLo[i] = (std::max(std::min(c0, c1), 1) - 1) / kLeafDim;
+            leafHi[i] = (std::min(std::max(c0, c1) + 1, kBrickSize) - 1) / kLeafDim;
         }
+        for (int x = leafLo.x; x <= leafHi.x; ++x)
+            for (int y = leafLo.y; y <= leafHi.y; ++y)
+                for (int z = leafLo.z; z <= leafHi.z; ++z)
+                    touchedLeaves_ |= std::uint64_t(1) << leafBit(x, y, z);
+        // The fractions inside the current cell are carried from piece to
+        // piece: they advance by (tB − tA)·d, and an axis whose cell boundary
+        // was crossed restarts exactly at 0 (stepping up) or 1 (down), so
+        // they stay in [0, 1] up to rounding without clamping.
+        Vec3i previous = floorToInt(s.at(t0));
+        Vec3d f = s.at(t0) - Vec3d(previous);
         traverseCells(s, t0, t1, cellMin, cellMax, [&](const Vec3i& cell, double tA, double tB) {
-            splatPiece(s, cell, tA, tB, length * (tB - tA), channel);
+            for (int i = 0; i < 3; ++i)
+                if (cell[i] != previous[i])
+                    f[i] = cell[i] > previous[i] ? 0.0 : 1.0;
+            previous = cell;
+            const Vec3d delta = (tB - tA) * s.d;
+            splatPiece(cell, f, delta, length * (tB - tA), channel);
+            f += delta;
         });
     }
 
     /// Emits the leaves of the brick's own voxels (local [1, 32]) that hold
-    /// fiber, and clears what was touched for the next brick.
+    /// fiber, and clears what was touched for the next brick: every corner a
+    /// segment reached is within one voxel of a voxel of a leaf it marked.
     void extract(const openvdb::Coord& brickOrigin, double invVoxelVolume, BrickLeaves& out) {
-        if (touchedMin_.x > touchedMax_.x)
-            return;
-        for (int lx = 0; lx < kLeavesPerBrickSide; ++lx)
-            for (int ly = 0; ly < kLeavesPerBrickSide; ++ly)
-                for (int lz = 0; lz < kLeavesPerBrickSide; ++lz) {
-                    const Vec3i lo = Vec3i(lx, ly, lz) * kLeafDim + 1;
-                    if (glm::any(glm::greaterThan(lo, touchedMax_)) ||
-                        glm::any(glm::lessThan(lo + (kLeafDim - 1), touchedMin_)))
-                        continue;
-                    extractLeaf(lo, brickOrigin + openvdb::Coord(lo.x - 1, lo.y - 1, lo.z - 1),
-                                invVoxelVolume, out);
+        forEachTouchedLeaf([&](const Vec3i& lo) {
+            extractLeaf(lo, brickOrigin + openvdb::Coord(lo.x - 1, lo.y - 1, lo.z - 1),
+                        invVoxelVolume, out);
+        });
+        // Only once all are read: the cleared blocks overlap neighbouring leaves.
+        forEachTouchedLeaf([&](const Vec3i& lo) {
+            for (int x = lo.x - 1; x <= lo.x + kLeafDim; ++x)
+                for (int y = lo.y - 1; y <= lo.y + kLeafDim; ++y) {
+                    double* row = &sums_[index(x, y, lo.z - 1)];
+                    std::fill(row, row + std::size_t(kLeafDim + 2) * C, 0.0);
                 }
-        for (int x = touchedMin_.x; x <= touchedMax_.x; ++x)
-            for (int y = touchedMin_.y; y <= touchedMax_.y; ++y) {
-                double* row = &sums_[index(x, y, touchedMin_.z)];
-                std::fill(row, row + std::size_t(touchedMax_.z - touchedMin_.z + 1) * C, 0.0);
-            }
-        touchedMin_ = Vec3i(kAccDim);
-        touchedMax_ = Vec3i(-1);
+        });
+        touchedLeaves_ = 0;
     }
 
 private:
@@ -420,17 +505,14 @@ private:
         return ((std::size_t(x) * kAccDim + std::size_t(y)) * kAccDim + std::size_t(z)) * C;
     }
 
-    /// Adds ∫ w_v ds · channel to the 8 corners of `cell` for the piece
-    /// t ∈ [tA, tB] of length `pieceLength`, exactly. With τ ∈ [0, 1] along
-    /// the piece, each fraction is linear, f_i(τ) = f_i + δ_i τ, and a
+    /// Adds ∫ w_v ds · channel, exactly, to the 8 corners of `cell` for a
+    /// piece of length `pieceLength` whose fractions in the cell go from f to
+    /// f + δ. With τ ∈ [0, 1] along the piece, f_i(τ) = f_i + δ_i τ, and a
     /// corner's weight is X·Y·Z with X ∈ {1 − f_x, f_x}, ... For each (Y, Z)
     /// pair the quadratic YZ has moments Q0 = ∫YZ dτ, Q1 = ∫τ YZ dτ, and then
     /// ∫ f_x YZ = f_x Q0 + δ_x Q1, ∫ (1 − f_x) YZ = Q0 − ∫ f_x YZ.
-    void splatPiece(const IndexSegment& s, const Vec3i& cell, double tA, double tB,
-                    double pieceLength, const std::array<double, C>& channel) {
-        const Vec3d c(cell);
-        const Vec3d f = glm::clamp(s.at(tA) - c, 0.0, 1.0);
-        const Vec3d delta = glm::clamp(s.at(tB) - c, 0.0, 1.0) - f;
+    void splatPiece(const Vec3i& cell, const Vec3d& f, const Vec3d& delta, double pieceLength,
+                    const std::array<Double2, C / 2>& channel) {
         // Moments of Y1 = f_y, Z1 = f_z and of their product P = Y1·Z1.
         constexpr double third = 1.0 / 3.0;
         const double y0 = f.y + 0.5 * delta.y, y1 = 0.5 * f.y + third * delta.y;
@@ -443,18 +525,28 @@ private:
         double* base = &sums_[index(cell.x, cell.y, cell.z)];
         constexpr std::size_t dz = C, dy = std::size_t(kAccDim) * C, dx = dy * kAccDim;
         constexpr std::size_t yzOffset[4] = {0, dz, dy, dy + dz};
+        // Weights that are 0 in exact arithmetic can come out as ±1e-16: they
+        // are clamped to 0, so every voxel's statistics stay convex
+        // combinations (|E[u]| ≤ 1, E[u uᵀ] positive semidefinite) however
+        // little length it receives.
 #pragma GCC unroll 4
         for (std::size_t k = 0; k < 4; ++k) {
             const double w1 = f.x * q0[k] + delta.x * q1[k];
-            const double w0 = (q0[k] - w1) * pieceLength;
-            const double w1s = w1 * pieceLength;
-            double* v0 = base + yzOffset[k];
-            double* v1 = v0 + dx;
-#pragma GCC unroll 10
-            for (std::size_t ch = 0; ch < C; ++ch) {
-                v0[ch] += w0 * channel[ch];
-                v1[ch] += w1s * channel[ch];
-            }
+            const double w0 = q0[k] - w1;
+            addChannels(base + yzOffset[k], std::max(w0, 0.0) * pieceLength, channel);
+            addChannels(base + yzOffset[k] + dx, std::max(w1, 0.0) * pieceLength, channel);
+        }
+    }
+
+    /// v[c] += w · channel[c] for the C channels of one voxel.
+    static void addChannels(double* v, double w, const std::array<Double2, C / 2>& channel) {
+        const Double2 w2{w, w};
+#pragma GCC unroll 5
+        for (std::size_t j = 0; j < C / 2; ++j) {
+            Double2 sum;
+            std::memcpy(&sum, v + 2 * j, sizeof sum);
+            sum += w2 * channel[j];
+            std::memcpy(v + 2 * j, &sum, sizeof sum);
         }
     }
 
@@ -473,13 +565,16 @@ private:
                         continue;
                     if (!density) {
                         density = std::make_unique<FloatLeaf>(origin, 0.0f, false);
-                        orientation = std::make_unique<Vec3SLeaf>(origin, openvdb::Vec3s(0.0f), false);
+                        orientation =
+                            std::make_unique<Vec3SLeaf>(origin, openvdb::Vec3s(0.0f), false);
                         if constexpr (Tensor) {
                             diag = std::make_unique<Vec3SLeaf>(origin, openvdb::Vec3s(0.0f), false);
-                            offDiag = std::make_unique<Vec3SLeaf>(origin, openvdb::Vec3s(0.0f), false);
+                            offDiag =
+                                std::make_unique<Vec3SLeaf>(origin, openvdb::Vec3s(0.0f), false);
                         }
                     }
-                    const openvdb::Index offset = FloatLeaf::coordToOffset(origin + openvdb::Coord(x, y, z));
+                    const openvdb::Index offset =
+                        FloatLeaf::coordToOffset(origin + openvdb::Coord(x, y, z));
                     const double inv = 1.0 / v[0];
                     const auto mean = [&](std::size_t ch) {
                         return openvdb::Vec3s(static_cast<float>(v[ch] * inv),
@@ -503,8 +598,22 @@ private:
         }
     }
 
+    static int leafBit(int x, int y, int z) {
+        return (x * kLeavesPerBrickSide + y) * kLeavesPerBrickSide + z;
+    }
+
+    /// f(first local voxel of the leaf) for every marked leaf.
+    template <typename F>
+    void forEachTouchedLeaf(const F& f) const {
+        for (int x = 0; x < kLeavesPerBrickSide; ++x)
+            for (int y = 0; y < kLeavesPerBrickSide; ++y)
+                for (int z = 0; z < kLeavesPerBrickSide; ++z)
+                    if (touchedLeaves_ >> leafBit(x, y, z) & 1)
+                        f(Vec3i(x, y, z) * kLeafDim + 1);
+    }
+
     std::vector<double> sums_;
-    Vec3i touchedMin_{kAccDim}, touchedMax_{-1}; ///< corners touched since the last extract
+    std::uint64_t touchedLeaves_ = 0; ///< leaves marked since the last extract, by leafBit()
 };
 
 template <bool Tensor>
@@ -513,8 +622,9 @@ std::vector<BrickLeaves> splatBricks(const Groom& groom, const BrickBuckets& buc
     const double invH = 1.0 / h, invVoxelVolume = 1.0 / (h * h * h);
     std::vector<BrickLeaves> leaves(buckets.bricks.size());
     tbb::enumerable_thread_specific<std::unique_ptr<BrickAccumulator<Tensor>>> accumulators;
-    forEachIndex(buckets.bricks.size(), threaded, [&](std::size_t b) {
+    forEachIndexInOrder(buckets.bricks.size(), threaded, [&](std::size_t k) {
         throwIfInterrupted();
+        const std::uint32_t b = buckets.largestFirst[k];
         auto& acc = accumulators.local();
         if (!acc)
             acc = std::make_unique<BrickAccumulator<Tensor>>();
@@ -551,7 +661,7 @@ std::vector<BrickLeaves> splatBricks(const Groom& groom, const BrickBuckets& buc
 struct GroomScan {
     Bounds3f bounds;
     double totalLength = 0;
-    Vec3d sumAbsDelta{0.0}; ///< Σ over segments of |Δx|, |Δy|, |Δz|
+    Vec3d sumAbsDelta{0.0};                         ///< Σ over segments of |Δx|, |Δy|, |Δz|
     std::size_t badStrand = SIZE_MAX, badPoint = 0; ///< first non-finite point
 };
 
@@ -559,7 +669,8 @@ GroomScan scanGroom(const Groom& groom, const std::vector<StrandRange>& chunks, 
     std::vector<GroomScan> perChunk(chunks.size());
     forEachIndex(chunks.size(), threaded, [&](std::size_t c) {
         GroomScan& scan = perChunk[c];
-        for (std::size_t s = chunks[c].begin; s < chunks[c].end && scan.badStrand == SIZE_MAX; ++s) {
+        for (std::size_t s = chunks[c].begin; s < chunks[c].end && scan.badStrand == SIZE_MAX;
+             ++s) {
             const auto pts = groom.strand(s);
             for (std::size_t k = 0; k < pts.size(); ++k) {
                 if (!isFinite(pts[k])) {
@@ -621,11 +732,12 @@ MemoryEstimate estimateMemory(const Groom& groom, const GroomScan& scan, double 
     e.leaves = std::min(boxLeaves, (strands + l1 / (h * kLeafDim)) * spill);
     const double leafBytes =
         double(sizeof(FloatLeaf) + FloatLeaf::SIZE * sizeof(float)) +
-        double(tensor ? 3 : 1) * double(sizeof(Vec3SLeaf) + Vec3SLeaf::SIZE * sizeof(openvdb::Vec3s));
+        double(tensor ? 3 : 1) *
+            double(sizeof(Vec3SLeaf) + Vec3SLeaf::SIZE * sizeof(openvdb::Vec3s));
     const double runs = 2.0 * (strands + l1 / (h * kBrickSize));
     const double accumulatorBytes = double(kAccDim) * kAccDim * kAccDim * (tensor ? 10 : 4) * 8;
     const double threads = threaded ? std::max(1, activeThreadCount()) : 1;
-    e.bytes = e.leaves * leafBytes + runs * double(sizeof(BrickRun) + sizeof(Run)) +
+    e.bytes = e.leaves * leafBytes + runs * double(sizeof(ChunkRuns::Entry) + sizeof(Run)) +
               threads * accumulatorBytes;
     return e;
 }
@@ -747,7 +859,9 @@ FiberGrid splatStrands(const Groom& groom, const SplatOptions& options) {
     return grid;
 }
 
-std::uint64_t FiberGrid::activeVoxelCount() const { return density ? density->activeVoxelCount() : 0; }
+std::uint64_t FiberGrid::activeVoxelCount() const {
+    return density ? density->activeVoxelCount() : 0;
+}
 
 std::uint64_t FiberGrid::memoryBytes() const {
     std::uint64_t bytes = 0;

@@ -72,11 +72,12 @@ inline constexpr const char* kTensorOffDiagGridName = "tensorOffDiag";
 /// (names in fiber_grid_io.cpp: voxel_size, fiber_diameter, density_scale,
 /// source_file, source_hash, strands, segments, total_length, hairvox_version).
 struct FiberGridInfo {
-    double voxelSize = 0;        ///< h, world units (metres for the procedural grooms)
-    float fiberDiameter = 8e-5f; ///< D, world units (metadata for consumers; λ does not depend on it)
-    float densityScale = 1.0f;   ///< one modeled strand stands for k real hairs (metadata)
-    std::string sourceFile;      ///< as given to splatStrands (the CLI passes the input path)
-    std::string sourceHash;      ///< hexDigest(contentHash(groom))
+    double voxelSize = 0; ///< h, world units (metres for the procedural grooms)
+    float fiberDiameter =
+        8e-5f; ///< D, world units (metadata for consumers; λ does not depend on it)
+    float densityScale = 1.0f; ///< one modeled strand stands for k real hairs (metadata)
+    std::string sourceFile;    ///< as given to splatStrands (the CLI passes the input path)
+    std::string sourceHash;    ///< hexDigest(contentHash(groom))
     std::uint64_t strands = 0, segments = 0;
     double totalLength = 0; ///< Σ segment lengths of the groom, world units
     std::string version;    ///< hairvox version that splatted the grid
@@ -129,7 +130,7 @@ struct SplatOptions {
     /// splatStrands refuses, before allocating, a voxel size whose estimated
     /// memory exceeds this.
     std::uint64_t memoryBudgetBytes = 4ull << 30;
-    std::string sourceFile; ///< recorded in FiberGridInfo
+    std::string sourceFile;    ///< recorded in FiberGridInfo
     bool showProgress = false; ///< progress bar on stderr
 };
 
