@@ -7,6 +7,7 @@ namespace hairvox::cli {
 
 void addGenerateCommand(CLI::App& app);
 void addInfoCommand(CLI::App& app);
+void addRenderCommand(CLI::App& app);
 void addTablesCommand(CLI::App& app);
 void addVoxelizeCommand(CLI::App& app);
 

@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
     app.require_subcommand(1, 1);
     hairvox::cli::addGenerateCommand(app);
     hairvox::cli::addInfoCommand(app);
+    hairvox::cli::addRenderCommand(app);
     hairvox::cli::addTablesCommand(app);
     hairvox::cli::addVoxelizeCommand(app);
     hairvox::installInterruptHandler();

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <span>
 
 namespace hairvox::detail {
 
@@ -117,6 +118,7 @@ void BrickVolume::set(const BrickSet& bricks, const glm::ivec3& local, const Opt
     }
 }
 
+
 template <typename F>
 void BrickVolume::walkBricks(const Vec3f& O, const Vec3f& dir, float s0, float s1, F&& visit) const {
     if (empty())
@@ -163,9 +165,72 @@ void BrickVolume::walkBricks(const Vec3f& O, const Vec3f& dir, float s0, float s
     }
 }
 
+template <typename NextSplit, typename OnPiece>
+void BrickVolume::forEachPiece(std::size_t brick, const glm::ivec3& b, const Vec3f& O,
+                               const Vec3f& dir, float sa, float sb, NextSplit&& nextSplit,
+                               OnPiece&& onPiece) const {
+    const Lanes* v = &values_[brick * kBrickValues];
+    const glm::ivec3 base = kBrick * b;
+    // The cell containing the start: on a cell face, the one the ray enters.
+    const Vec3f pa = O + sa * dir;
+    glm::ivec3 c;
+    glm::ivec3 step;
+    Vec3f sNext, sDelta;
+    for (int a = 0; a < 3; ++a) {
+        int ci = static_cast<int>(std::floor(pa[a]));
+        if (dir[a] < 0 && static_cast<float>(ci) == pa[a])
+            --ci;
+        c[a] = std::clamp(ci, base[a], base[a] + kBrick - 1);
+        step[a] = dir[a] > 0 ? 1 : (dir[a] < 0 ? -1 : 0);
+        sDelta[a] = dir[a] != 0 ? 1.0f / std::abs(dir[a]) : kInfinity;
+        sNext[a] = dir[a] != 0 ? (float(c[a] + (dir[a] > 0 ? 1 : 0)) - O[a]) / dir[a] : kInfinity;
+    }
+    // The field is continuous: a piece's end value is the next piece's start value.
+    float s = sa;
+    Lanes fStart;
+    bool haveStart = false;
+    for (;;) {
+        const float sEnd = std::min({sNext.x, sNext.y, sNext.z, sb});
+        if (sEnd > s) {
+            const glm::ivec3 l = c - base;
+            const Lanes* corner[8];
+            bool any = false;
+            for (int k = 0; k < 8; ++k) {
+                corner[k] = &v[valueIndex(l.x + (k >> 2), l.y + ((k >> 1) & 1), l.z + (k & 1))];
+                any = any || corner[k]->v[0] != 0.0f;
+            }
+            if (any) {
+                const Vec3f cf(c);
+                const auto at = [&](float t) { return trilinear(corner, O + t * dir - cf); };
+                if (!haveStart)
+                    fStart = at(s);
+                for (float a = s; a < sEnd;) {
+                    const float e = std::min(nextSplit(a), sEnd);
+                    const Lanes fEnd = at(e);
+                    onPiece(a, e, fStart, at(0.5f * (a + e)), fEnd);
+                    fStart = fEnd;
+                    a = e;
+                }
+            } else {
+                fStart = Lanes{};
+            }
+            haveStart = true;
+        }
+        if (sEnd >= sb)
+            break;
+        s = sEnd;
+        const int a = sNext.x <= sNext.y ? (sNext.x <= sNext.z ? 0 : 2) : (sNext.y <= sNext.z ? 1 : 2);
+        c[a] += step[a];
+        sNext[a] += sDelta[a];
+        if (c[a] < base[a] || c[a] >= base[a] + kBrick)
+            break;
+    }
+}
+
 OpticalDepths BrickVolume::integrate(const Vec3f& origin, const Vec3f& dir, float tStart,
                                      float tEnd, float opaqueDepth, bool& touched) const {
     // Index space: p(s) = O + s·dir with s = t/h; the sum is scaled by h at the end.
+    // Simpson's rule per cell piece is exact: the trilinear field is a cubic along a line.
     const Vec3f O = origin * invH_;
     const float opaqueSum = opaqueDepth * invH_;
     Lanes sum;
@@ -173,42 +238,58 @@ OpticalDepths BrickVolume::integrate(const Vec3f& origin, const Vec3f& dir, floa
     walkBricks(O, dir, tStart * invH_, std::isinf(tEnd) ? kInfinity : tEnd * invH_,
                [&](std::size_t brick, const glm::ivec3& b, float s, float sExit) {
                    touched = true;
-                   integrateBrick(brick, b, O, dir, s, sExit, sum);
-                   return !(sum.v[0] > opaqueSum &&
-                            std::min({sum.v[1], sum.v[2], sum.v[3]}) > opaqueSum);
+                   forEachPiece(
+                       brick, b, O, dir, s, sExit, [](float) { return kInfinity; },
+                       [&](float s0, float s1, const Lanes& f0, const Lanes& fm, const Lanes& f1) {
+                           addSimpson(sum, f0, fm, f1, (s1 - s0) / 6.0f);
+                       });
+                   return !sum.opaque(opaqueSum);
                });
     return sum.depths() * static_cast<float>(h_);
 }
 
-float BrickVolume::firstBrickEntry(const Vec3f& origin, const Vec3f& dir, float tStart,
-                                   float tEnd) const {
-    float entry = kInfinity;
-    walkBricks(origin * invH_, dir, tStart * invH_, std::isinf(tEnd) ? kInfinity : tEnd * invH_,
-               [&](std::size_t, const glm::ivec3&, float s, float) {
-                   entry = s * static_cast<float>(h_);
-                   return false;
+std::size_t BrickVolume::integrateCumulative(const Vec3f& origin, const Vec3f& dir, float tStart,
+                                             float step, float opaqueDepth,
+                                             std::span<Lanes> out) const {
+    if (out.empty())
+        return 0;
+    const Vec3f O = origin * invH_;
+    const float opaqueSum = opaqueDepth * invH_;
+    const float sStart = tStart * invH_, sStep = step * invH_;
+    const auto count = out.size();
+    Lanes sum;
+    std::size_t next = 0; // the next sample to record
+    // Records every sample at or before s with the running sum (in world units).
+    const auto recordUpTo = [&](float s) {
+        for (; next < count && sStart + static_cast<float>(next) * sStep <= s; ++next) {
+            out[next] = sum;
+            for (float& lane : out[next].v)
+                lane *= static_cast<float>(h_);
+        }
+    };
+    bool opaque = false;
+    walkBricks(O, dir, sStart, sStart + static_cast<float>(count - 1) * sStep,
+               [&](std::size_t brick, const glm::ivec3& b, float s, float sExit) {
+                   recordUpTo(s);
+                   // Pieces end at sample positions, where the running sum is recorded.
+                   forEachPiece(
+                       brick, b, O, dir, s, sExit,
+                       [&](float t) {
+                           const float k = std::floor((t - sStart) / sStep) + 1.0f;
+                           const float split = sStart + k * sStep;
+                           return split > t ? split : split + sStep; // rounding at a sample
+                       },
+                       [&](float s0, float s1, const Lanes& f0, const Lanes& fm, const Lanes& f1) {
+                           addSimpson(sum, f0, fm, f1, (s1 - s0) / 6.0f);
+                           recordUpTo(s1);
+                       });
+                   opaque = sum.opaque(opaqueSum);
+                   return !opaque;
                });
-    return entry;
-}
-
-bool BrickVolume::contains(const Vec3f& position) const {
-    return find(glm::ivec3(glm::floor(position * invH_)) >> 3) >= 0;
-}
-
-BrickVolume BrickVolume::emptyCopy() const {
-    BrickVolume copy(h_);
-    copy.slots_ = slots_;
-    copy.brickCount_ = brickCount_;
-    copy.brickCoord_ = brickCoord_;
-    copy.values_.assign(values_.size(), Lanes{});
-    copy.brickMin_ = brickMin_;
-    copy.brickMax_ = brickMax_;
-    return copy;
-}
-
-void BrickVolume::setValue(std::size_t index, const glm::ivec3& l, const OpticalDepths& value) {
-    values_[index * kBrickValues + static_cast<std::size_t>(valueIndex(l.x, l.y, l.z))] =
-        Lanes::from(value);
+    if (opaque)
+        return next;
+    recordUpTo(std::numeric_limits<float>::max());
+    return count;
 }
 
 OpticalDepths BrickVolume::sample(const Vec3f& position) const {
@@ -226,62 +307,13 @@ OpticalDepths BrickVolume::sample(const Vec3f& position) const {
     return trilinear(corner, q - Vec3f(c)).depths();
 }
 
-void BrickVolume::integrateBrick(std::size_t brick, const glm::ivec3& b, const Vec3f& O,
-                                const Vec3f& dir, float sa, float sb, Lanes& sum) const {
-    const Lanes* v = &values_[brick * kBrickValues];
-    const glm::ivec3 base = kBrick * b;
-    // The cell containing the start: on a cell face, the one the ray enters.
-    const Vec3f pa = O + sa * dir;
-    glm::ivec3 c;
-    glm::ivec3 step;
-    Vec3f sNext, sDelta;
-    for (int a = 0; a < 3; ++a) {
-        int ci = static_cast<int>(std::floor(pa[a]));
-        if (dir[a] < 0 && static_cast<float>(ci) == pa[a])
-            --ci;
-        c[a] = std::clamp(ci, base[a], base[a] + kBrick - 1);
-        step[a] = dir[a] > 0 ? 1 : (dir[a] < 0 ? -1 : 0);
-        sDelta[a] = dir[a] != 0 ? 1.0f / std::abs(dir[a]) : kInfinity;
-        sNext[a] = dir[a] != 0 ? (float(c[a] + (dir[a] > 0 ? 1 : 0)) - O[a]) / dir[a] : kInfinity;
+Bounds3f BrickVolume::bounds() const {
+    Bounds3f b;
+    if (!empty()) {
+        b.extend(Vec3f(kBrick * brickMin_) * static_cast<float>(h_));
+        b.extend(Vec3f(kBrick * (brickMax_ + 1)) * static_cast<float>(h_));
     }
-    // The field is continuous: a cell's exit value is the next cell's entry value.
-    float s = sa;
-    Lanes fEntry;
-    bool haveEntry = false;
-    for (;;) {
-        const float sEnd = std::min({sNext.x, sNext.y, sNext.z, sb});
-        if (sEnd > s) {
-            const glm::ivec3 l = c - base;
-            const Lanes* corner[8];
-            bool any = false;
-            for (int k = 0; k < 8; ++k) {
-                corner[k] = &v[valueIndex(l.x + (k >> 2), l.y + ((k >> 1) & 1), l.z + (k & 1))];
-                any = any || corner[k]->v[0] != 0.0f;
-            }
-            if (any) {
-                // Simpson's rule: exact for the cubic the trilinear field is along a line.
-                const Vec3f cf(c);
-                if (!haveEntry)
-                    fEntry = trilinear(corner, O + s * dir - cf);
-                const Lanes fExit = trilinear(corner, O + sEnd * dir - cf);
-                addSimpson(sum, fEntry, trilinear(corner, O + (0.5f * (s + sEnd)) * dir - cf),
-                           fExit, (sEnd - s) / 6.0f);
-                fEntry = fExit;
-                haveEntry = true;
-            } else {
-                fEntry = Lanes{};
-                haveEntry = true;
-            }
-        }
-        if (sEnd >= sb)
-            break;
-        s = sEnd;
-        const int a = sNext.x <= sNext.y ? (sNext.x <= sNext.z ? 0 : 2) : (sNext.y <= sNext.z ? 1 : 2);
-        c[a] += step[a];
-        sNext[a] += sDelta[a];
-        if (c[a] < base[a] || c[a] >= base[a] + kBrick)
-            break;
-    }
+    return b;
 }
 
 } // namespace hairvox::detail

@@ -17,6 +17,7 @@
 #include <glm/vec3.hpp>
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 namespace hairvox::detail {
@@ -44,6 +45,9 @@ struct alignas(32) Lanes {
 
     static Lanes from(const OpticalDepths& d) {
         return {{d.n, d.tauP.r, d.tauP.g, d.tauP.b, d.sumBeta2.r, d.sumBeta2.g, d.sumBeta2.b, 0.0f}};
+    }
+    bool opaque(float depth) const {
+        return v[0] > depth && v[1] > depth && v[2] > depth && v[3] > depth;
     }
     OpticalDepths depths() const {
         return {v[0], Rgb(v[1], v[2], v[3]), Rgb(v[4], v[5], v[6])};
@@ -76,8 +80,9 @@ public:
     void reserveBrick(const glm::ivec3& b, int lowFaces);
     BrickSet brickSet(const glm::ivec3& b) const;
     /// Stores the value of the voxel at `local` ∈ [0, 8)³ of the brick set's
-    /// brick. Thread-safe for distinct voxels.
+    /// brick, in its brick and the aprons below. Thread-safe for distinct voxels.
     void set(const BrickSet& bricks, const glm::ivec3& local, const OpticalDepths& value);
+
 
     /// ∫_{tStart}^{tEnd} of the trilinear field along origin + t·dir (dir unit,
     /// world units), exact. Stops early once n and every channel of tauP
@@ -85,24 +90,19 @@ public:
     OpticalDepths integrate(const Vec3f& origin, const Vec3f& dir, float tStart, float tEnd,
                             float opaqueDepth, bool& touched) const;
 
+    /// Cumulative integrals along origin + t·dir at t_k = tStart + k·step:
+    /// out[k] = ∫_{tStart}^{t_k}, k = 0 .. out.size() − 1 (out[0] = 0). Stops
+    /// once n and every channel of tauP exceed `opaqueDepth`; returns how many
+    /// entries it filled (the rest would only grow).
+    std::size_t integrateCumulative(const Vec3f& origin, const Vec3f& dir, float tStart, float step,
+                                    float opaqueDepth, std::span<Lanes> out) const;
+
     /// The trilinear value at a world position (zero outside every brick).
     OpticalDepths sample(const Vec3f& position) const;
-    /// Whether the cell containing `position` belongs to a brick.
-    bool contains(const Vec3f& position) const;
-    /// The smallest t ∈ [tStart, tEnd) at which origin + t·dir is inside a
-    /// brick, or +∞.
-    float firstBrickEntry(const Vec3f& origin, const Vec3f& dir, float tStart, float tEnd) const;
+    /// World-space bounds of every brick.
+    Bounds3f bounds() const;
 
-    /// A volume with the same bricks, every value zero.
-    BrickVolume emptyCopy() const;
-    /// Brick coordinate of brick `index` (< brickCount()).
-    const glm::ivec3& brickCoord(std::size_t index) const { return brickCoord_[index]; }
-    /// World position of the value at `local` ∈ [0, 9)³ of brick `index`.
-    Vec3f position(std::size_t index, const glm::ivec3& local) const {
-        return Vec3f(kBrick * brickCoord_[index] + local) * static_cast<float>(h_);
-    }
-    /// Sets one value at `local` ∈ [0, 9)³ of brick `index` (no apron propagation).
-    void setValue(std::size_t index, const glm::ivec3& local, const OpticalDepths& value);
+
 
 private:
     /// Calls visit(brickIndex, brickCoord, sEnter, sExit) for the bricks that
@@ -110,8 +110,13 @@ private:
     /// returns true.
     template <typename F>
     void walkBricks(const Vec3f& O, const Vec3f& dir, float s0, float s1, F&& visit) const;
-    void integrateBrick(std::size_t brick, const glm::ivec3& b, const Vec3f& O, const Vec3f& dir,
-                        float sa, float sb, Lanes& sum) const;
+    /// Walks the cells of one brick over s ∈ [sa, sb), cut further at
+    /// nextSplit(s) (the next cut after s), calling onPiece(s0, s1, f0, fm, f1)
+    /// with the field at each piece's ends and middle (nothing for cells whose
+    /// corners are all zero).
+    template <typename NextSplit, typename OnPiece>
+    void forEachPiece(std::size_t brick, const glm::ivec3& b, const Vec3f& O, const Vec3f& dir,
+                      float sa, float sb, NextSplit&& nextSplit, OnPiece&& onPiece) const;
     /// Index of the brick at brick coordinate b, or −1.
     std::int64_t find(const glm::ivec3& b) const;
     std::int64_t insert(const glm::ivec3& b);

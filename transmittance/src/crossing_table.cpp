@@ -48,6 +48,11 @@ CrossingTable CrossingTable::build(const std::function<Rgb(float theta)>& aBar_f
     return table;
 }
 
+CrossingTable CrossingTable::fromDualScattering(const DualScatteringTables& tables) {
+    return build([&](float theta) { return tables.aBar_f(theta); },
+                 [&](float theta) { return tables.beta2Bar_f(theta); });
+}
+
 std::pair<std::size_t, float> CrossingTable::locate(float s) const {
     const float x = (safeASin(std::clamp(s, -1.0f, 1.0f)) + static_cast<float>(PiOver2)) * scale_;
     const auto i = std::min(static_cast<std::size_t>(std::max(x, 0.0f)), entries_.size() - 2);

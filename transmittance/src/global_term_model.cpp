@@ -63,7 +63,10 @@ public:
         return stats;
     }
 
-    bool seesNoHair() const override { return inner_->seesNoHair(); }
+    bool blocksEverything() const override {
+        return (light_.kind == LightGeometry::Kind::Point && occluder_.contains(light_.position)) ||
+               inner_->blocksEverything();
+    }
 
 private:
     std::unique_ptr<LightGlobalTerm> inner_;

@@ -1,6 +1,7 @@
 // The grid and approx modes: per-light rate volumes built from the fiber grid
 // and integrated along shadow rays (see grid_global_term.h).
 #include "brick_volume.h"
+#include "light_space_cache.h"
 
 #include <hairvox/core/error.h>
 #include <hairvox/core/interrupt.h>
@@ -19,6 +20,7 @@ namespace hairvox {
 
 using detail::OpticalDepths;
 using detail::BrickVolume;
+using detail::LightSpaceCache;
 
 const char* toString(OrientationModel model) {
     switch (model) {
@@ -49,9 +51,6 @@ void GridOptions::validate(const FiberGrid& grid) const {
     if (!(startOffset >= 0 && startOffset <= 8))
         throw InputError(strCat("grid start offset = ", startOffset,
                                 " voxels should be in the range [0, 8]"));
-    if (!(cacheStep >= 2 && cacheStep <= 64))
-        throw InputError(strCat("grid cache step = ", cacheStep,
-                                " voxels should be in the range [2, 64]"));
     if (orientation == OrientationModel::Tensor && !grid.hasTensor())
         throw InputError("the tensor orientation model needs a fiber grid with the orientation "
                          "tensor (voxelize --orientation-tensor)");
@@ -63,8 +62,7 @@ std::ostream& operator<<(std::ostream& os, const GridOptions& options) {
     return os << "GridOptions(orientation=" << toString(options.orientation)
               << ", estimator=" << toString(options.estimator)
               << ", evaluation=" << toString(options.evaluation)
-              << ", startOffset=" << options.startOffset << " voxels, cacheStep="
-              << options.cacheStep << " voxels)";
+              << ", startOffset=" << options.startOffset << " voxels)";
 }
 
 namespace {
@@ -190,110 +188,12 @@ BrickVolume GridModel::buildRates(const LightGeometry& light) const {
     return volume;
 }
 
-/// The cache volume: at every vertex of `rates`, the integral to the light
-/// (see grid_global_term.h for the sweep). Each brick's 8³ own vertices are
-/// computed once and copied into the aprons of the bricks below; apron
-/// vertices whose owning brick does not exist are computed where they are.
-BrickVolume buildCache(const BrickVolume& rates, const LightGeometry& light, float stepVoxels) {
-    BrickVolume cache = rates.emptyCopy();
-    const auto h = static_cast<float>(rates.voxelSize());
-    const float delta = stepVoxels * h;
-    // A vertex reads the cache at ≥ Δ toward the light, whose trilinear corners
-    // are at most √3·h farther from it: slabs this thin only read earlier slabs.
-    const float slab = delta - 1.75f * h;
-    constexpr int kBrick = BrickVolume::kBrick;
-
-    struct Vertex {
-        float key;          ///< larger is nearer the light
-        std::uint32_t brick;
-        std::uint8_t x, y, z; ///< local coordinates, [0, 9)
-        bool owned;         ///< an own vertex (< 8 on every axis), copied to the aprons below
-    };
-    std::vector<BrickVolume::BrickSet> brickSets(cache.brickCount());
-    std::vector<Vertex> vertices;
-    vertices.reserve(cache.brickCount() * kBrick * kBrick * kBrick);
-    float keyMax = -std::numeric_limits<float>::infinity();
-    for (std::size_t b = 0; b < cache.brickCount(); ++b) {
-        brickSets[b] = cache.brickSet(cache.brickCoord(b));
-        for (int x = 0; x <= kBrick; ++x)
-            for (int y = 0; y <= kBrick; ++y)
-                for (int z = 0; z <= kBrick; ++z) {
-                    const glm::ivec3 l(x, y, z);
-                    const bool owned = x < kBrick && y < kBrick && z < kBrick;
-                    if (!owned && cache.contains(cache.position(b, l) + 0.5f * h))
-                        continue; // another brick owns it and fills this apron
-                    const Vec3f p = cache.position(b, l);
-                    const float key = light.kind == LightGeometry::Kind::Directional
-                                          ? glm::dot(p, light.direction)
-                                          : -glm::distance(p, light.position);
-                    keyMax = std::max(keyMax, key);
-                    vertices.push_back({key, static_cast<std::uint32_t>(b),
-                                        static_cast<std::uint8_t>(x), static_cast<std::uint8_t>(y),
-                                        static_cast<std::uint8_t>(z), owned});
-                }
-    }
-    // Counting sort into slabs (stable: the order within a slab is deterministic).
-    const auto slabOf = [&](const Vertex& v) {
-        return static_cast<std::size_t>((keyMax - v.key) / slab);
-    };
-    std::size_t slabs = 0;
-    for (const Vertex& v : vertices)
-        slabs = std::max(slabs, slabOf(v) + 1);
-    std::vector<std::size_t> slabStart(slabs + 1, 0);
-    for (const Vertex& v : vertices)
-        ++slabStart[slabOf(v) + 1];
-    for (std::size_t k = 0; k < slabs; ++k)
-        slabStart[k + 1] += slabStart[k];
-    {
-        std::vector<Vertex> sorted(vertices.size());
-        std::vector<std::size_t> next(slabStart.begin(), slabStart.end() - 1);
-        for (const Vertex& v : vertices)
-            sorted[next[slabOf(v)]++] = v;
-        vertices.swap(sorted);
-    }
-
-    const float epsilon = 1e-3f * h; // past a brick face, into the brick
-    for (std::size_t k = 0; k < slabs; ++k) {
-        throwIfInterrupted();
-        tbb::parallel_for(
-            tbb::blocked_range<std::size_t>(slabStart[k], slabStart[k + 1], 256),
-            [&](const tbb::blocked_range<std::size_t>& range) {
-                for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                    const Vertex& v = vertices[i];
-                    const glm::ivec3 l(v.x, v.y, v.z);
-                    const Vec3f p = cache.position(v.brick, l);
-                    const LightGeometry::Path path = light.pathFrom(p);
-                    bool touched = false;
-                    OpticalDepths d = rates.integrate(p, path.omega, 0.0f,
-                                                      std::min(delta, path.distance),
-                                                      kOpaqueDepth, touched);
-                    if (delta < path.distance) {
-                        // Usually the step ends inside a brick; otherwise the
-                        // path crosses empty space to the next brick (or none).
-                        const Vec3f q = p + delta * path.omega;
-                        const float t = cache.contains(q) ? delta
-                                                          : cache.firstBrickEntry(p, path.omega,
-                                                                                  delta, path.distance);
-                        if (std::isfinite(t))
-                            d += cache.sample(p + (t + epsilon) * path.omega);
-                    }
-                    if (v.owned)
-                        cache.set(brickSets[v.brick], l, d);
-                    else
-                        cache.setValue(v.brick, l, d);
-                }
-            });
-    }
-    return cache;
-}
-
 class GridLightGlobalTerm final : public LightGlobalTerm {
 public:
     GridLightGlobalTerm(const GridModel& model, const LightGeometry& light)
         : model_(model), light_(light), rates_(model.buildRates(light)) {
         if (model.options().evaluation == GridEvaluation::Cache)
-            cache_ = std::make_unique<BrickVolume>(
-                buildCache(rates_, light, model.options().cacheStep));
+            cache_ = LightSpaceCache::build(rates_, light, kOpaqueDepth);
     }
 
     GlobalTermStats evaluate(std::span<const GlobalTermQuery> queries,
@@ -321,9 +221,8 @@ private:
         if (!(path.distance > start))
             return GlobalTerm::unoccluded();
         OpticalDepths d;
-        const Vec3f first = q.position + start * path.omega;
-        if (cache_ && cache_->contains(first)) {
-            d = cache_->sample(first);
+        if (cache_) {
+            d = cache_->lookup(q.position + start * path.omega);
             touched = d.n > 0;
         } else {
             d = rates_.integrate(q.position, path.omega, start, path.distance, kOpaqueDepth,
@@ -344,7 +243,8 @@ private:
     const GridModel& model_;
     LightGeometry light_;
     BrickVolume rates_;
-    std::unique_ptr<BrickVolume> cache_; ///< null when evaluating by march
+    /// Empty when evaluating by march, or for a point light inside the volume.
+    std::optional<LightSpaceCache> cache_;
 };
 
 std::unique_ptr<LightGlobalTerm> GridModel::forLight(const LightGeometry& light) const {

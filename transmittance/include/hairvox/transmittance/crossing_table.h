@@ -21,6 +21,7 @@
 #pragma once
 
 #include <hairvox/core/rgb.h>
+#include <hairvox/shading/dual_scattering_tables.h>
 
 #include <functional>
 #include <vector>
@@ -51,11 +52,13 @@ public:
         Rates operator+(const Rates& o) const { return Rates(*this) += o; }
     };
 
-    /// Tabulates from functions of the inclination θ ∈ [−π/2, π/2] (radians),
-    /// typically DualScatteringTables::aBar_f and ::beta2Bar_f.
+    /// Tabulates from functions of the inclination θ ∈ [−π/2, π/2] (radians).
+    /// Throws std::invalid_argument if either returns a non-finite value.
     static CrossingTable build(const std::function<Rgb(float theta)>& aBar_f,
                                const std::function<Rgb(float theta)>& beta2Bar_f,
                                int samples = 1025);
+    /// From a fiber's dual-scattering tables (ā_f and β̄_f²).
+    static CrossingTable fromDualScattering(const DualScatteringTables& tables);
 
     /// Per-crossing values at s = sin θ = ω·u (clamped to [−1, 1]).
     Values crossing(float sinTheta) const;

@@ -55,9 +55,10 @@ public:
     /// any thread count and any batching.
     virtual GlobalTermStats evaluate(std::span<const GlobalTermQuery> queries,
                                      std::span<GlobalTerm> out) const = 0;
-    /// True when the light cannot reach the hair through anything: every
-    /// query evaluates to GlobalTerm::unoccluded() (or blocked by the head).
-    virtual bool seesNoHair() const { return false; }
+    /// True when the light can reach no point at all (a point light inside the
+    /// opaque head): every query would be GlobalTerm::blocked(), so a renderer
+    /// skips the light.
+    virtual bool blocksEverything() const { return false; }
 };
 
 /// Inputs every mode shares.

@@ -19,13 +19,13 @@
 //  - march: each query integrates from its point to the light. Cost per query
 //    grows with the path length through hair, and a march is memory-bound
 //    (random access to the volume): fine for probes, slow for a frame.
-//  - cache (default): forLight() first computes the integral from every vertex
-//    of the volume to the light by a sweep — vertices are processed in slabs of
-//    decreasing distance to the light; each integrates exactly over a step of
-//    Δ voxels toward the light and adds the (trilinearly interpolated) cached
-//    value there, which an earlier slab computed. A query is then one trilinear
-//    lookup. The interpolation at each step blurs shadows by about a voxel over
-//    a long path; the error against exact mode is measured in the tests.
+//  - cache (default): forLight() first integrates shadow lines through the
+//    volume, once each and exactly — parallel to a directional light, or
+//    radiating from a point light outside the volume — one line per voxel
+//    spacing, storing the running integral every voxel along it. A query
+//    interpolates 4 lines (a point light inside the volume falls back to march).
+//    The interpolation between lines is about a voxel wide, like the volume's
+//    own reconstruction; the error against exact mode is measured in the tests.
 //
 // Self-shadowing: the query point's own fiber is splatted into the voxels
 // around it; the integral starts `startOffset` voxels toward the light to leave
@@ -75,7 +75,6 @@ struct GridOptions {
     AttenuationEstimator estimator = AttenuationEstimator::Poisson;
     GridEvaluation evaluation = GridEvaluation::Cache;
     float startOffset = 0.0f; ///< voxels toward the light before integrating, [0, 8]
-    float cacheStep = 3.0f;   ///< Δ of the cache sweep, voxels, [2, 64]
 
     void validate(const FiberGrid& grid) const;
 };

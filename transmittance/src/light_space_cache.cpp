@@ -1,0 +1,191 @@
+#include "light_space_cache.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+namespace hairvox::detail {
+
+namespace {
+
+std::array<Vec3f, 8> corners(const Bounds3f& b) {
+    std::array<Vec3f, 8> c;
+    for (int k = 0; k < 8; ++k)
+        c[static_cast<std::size_t>(k)] = Vec3f((k & 4) ? b.max.x : b.min.x,
+                                               (k & 2) ? b.max.y : b.min.y,
+                                               (k & 1) ? b.max.z : b.min.z);
+    return c;
+}
+
+} // namespace
+
+std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates,
+                                                      const LightGeometry& light,
+                                                      float opaqueDepth) {
+    LightSpaceCache cache;
+    cache.h_ = static_cast<float>(rates.voxelSize());
+    const Bounds3f bounds = rates.bounds();
+    if (bounds.empty()) {
+        cache.lineStart_.assign(1, 0);
+        return cache;
+    }
+    const auto boxCorners = corners(bounds);
+
+    float sMaxWorld = 0; // farthest lattice distance the volume reaches, world units
+    if (light.kind == LightGeometry::Kind::Directional) {
+        cache.axis_ = -light.direction;
+        coordinateSystem(cache.axis_, cache.e1_, cache.e2_);
+        cache.du_ = cache.h_;
+        float sMin = std::numeric_limits<float>::infinity();
+        sMaxWorld = -sMin;
+        for (const Vec3f& c : boxCorners) {
+            sMin = std::min(sMin, glm::dot(c, cache.axis_));
+            sMaxWorld = std::max(sMaxWorld, glm::dot(c, cache.axis_));
+        }
+        cache.sBase_ = sMin - cache.h_;
+    } else {
+        // A perspective lattice needs the whole volume in front of the light,
+        // within a cone of half-angle < 60° (so that the lattice stays regular).
+        cache.perspective_ = true;
+        cache.origin_ = light.position;
+        const Vec3f toCentre = bounds.center() - light.position;
+        const float centreDistance = glm::length(toCentre);
+        if (!(centreDistance > 0))
+            return std::nullopt;
+        cache.axis_ = toCentre / centreDistance;
+        coordinateSystem(cache.axis_, cache.e1_, cache.e2_);
+        float sMin = std::numeric_limits<float>::infinity();
+        for (const Vec3f& c : boxCorners) {
+            const Vec3f d = c - light.position;
+            const float w = glm::dot(d, cache.axis_);
+            if (!(w > 0.5f * glm::length(d)))
+                return std::nullopt; // the light is inside or beside the volume
+            sMaxWorld = std::max(sMaxWorld, glm::length(d));
+        }
+        const Vec3f nearest = glm::clamp(light.position, bounds.min, bounds.max);
+        sMin = glm::distance(nearest, light.position);
+        cache.du_ = cache.h_ / glm::dot(toCentre, cache.axis_);
+        cache.sBase_ = std::max(sMin - cache.h_, 0.0f);
+    }
+
+    // The line lattice covering the volume's projection, with a margin of one line.
+    float uMin = std::numeric_limits<float>::infinity(), uMax = -uMin, vMin = uMin, vMax = uMax;
+    for (const Vec3f& c : boxCorners) {
+        const Vec3f l = cache.toLattice(c);
+        uMin = std::min(uMin, l.x);
+        uMax = std::max(uMax, l.x);
+        vMin = std::min(vMin, l.y);
+        vMax = std::max(vMax, l.y);
+    }
+    cache.i0_ = static_cast<int>(std::floor(uMin)) - 1;
+    cache.j0_ = static_cast<int>(std::floor(vMin)) - 1;
+    cache.ni_ = static_cast<int>(std::ceil(uMax)) + 2 - cache.i0_;
+    cache.nj_ = static_cast<int>(std::ceil(vMax)) + 2 - cache.j0_;
+    // (toLattice() used i0 = j0 = 0 above; lattice coordinates are now relative.)
+    const auto samplesPerLine =
+        static_cast<std::size_t>(std::ceil((sMaxWorld - cache.sBase_) / cache.h_)) + 2;
+
+    const auto lines = static_cast<std::size_t>(cache.ni_) * static_cast<std::size_t>(cache.nj_);
+    std::vector<std::vector<Lanes>> stored(lines);
+    std::vector<std::int32_t> k0(lines, 0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, lines, 64), [&](const auto& range) {
+        std::vector<Lanes> buffer(samplesPerLine);
+        for (std::size_t line = range.begin(); line != range.end(); ++line) {
+            Vec3f dir;
+            const Vec3f origin = cache.lineOrigin(static_cast<int>(line % std::size_t(cache.ni_)),
+                                                  static_cast<int>(line / std::size_t(cache.ni_)), dir);
+            const std::size_t filled =
+                rates.integrateCumulative(origin, dir, 0.0f, cache.h_, opaqueDepth, buffer);
+            // Keep from the sample before the first non-zero one (zero before).
+            std::size_t first = 0;
+            while (first < filled && buffer[first].v[0] == 0.0f && buffer[first].v[1] == 0.0f)
+                ++first;
+            if (first == filled)
+                continue;
+            first = first > 0 ? first - 1 : 0;
+            k0[line] = static_cast<std::int32_t>(first);
+            stored[line].assign(buffer.begin() + static_cast<std::ptrdiff_t>(first),
+                                buffer.begin() + static_cast<std::ptrdiff_t>(filled));
+        }
+    });
+    cache.lineStart_.resize(lines + 1, 0);
+    for (std::size_t line = 0; line < lines; ++line)
+        cache.lineStart_[line + 1] =
+            cache.lineStart_[line] + static_cast<std::uint32_t>(stored[line].size());
+    cache.samples_.reserve(cache.lineStart_.back());
+    for (std::size_t line = 0; line < lines; ++line)
+        cache.samples_.insert(cache.samples_.end(), stored[line].begin(), stored[line].end());
+    cache.lineK0_ = std::move(k0);
+    return cache;
+}
+
+Vec3f LightSpaceCache::toLattice(const Vec3f& p) const {
+    if (!perspective_)
+        return {glm::dot(p, e1_) / du_ - float(i0_), glm::dot(p, e2_) / du_ - float(j0_),
+                (glm::dot(p, axis_) - sBase_) / h_};
+    const Vec3f d = p - origin_;
+    const float w = std::max(glm::dot(d, axis_), 1e-30f);
+    return {glm::dot(d, e1_) / (w * du_) - float(i0_), glm::dot(d, e2_) / (w * du_) - float(j0_),
+            (glm::length(d) - sBase_) / h_};
+}
+
+Vec3f LightSpaceCache::lineOrigin(int i, int j, Vec3f& dir) const {
+    const float u = float(i + i0_) * du_, v = float(j + j0_) * du_;
+    if (!perspective_) {
+        dir = axis_;
+        return u * e1_ + v * e2_ + sBase_ * axis_;
+    }
+    dir = glm::normalize(axis_ + u * e1_ + v * e2_);
+    return origin_ + sBase_ * dir;
+}
+
+Lanes LightSpaceCache::alongLine(std::size_t line, float s) const {
+    const std::uint32_t begin = lineStart_[line], end = lineStart_[line + 1];
+    if (begin == end)
+        return {};
+    const float local = s - float(lineK0_[line]);
+    if (local <= 0)
+        return local <= -1.0f ? Lanes{} : samples_[begin]; // the first stored sample is the last zero
+    const auto count = end - begin;
+    const auto k = static_cast<std::uint32_t>(local);
+    if (k + 1 >= count)
+        return samples_[end - 1]; // past the volume or opaque: unchanged from here on
+    const float t = local - float(k);
+    const Lanes& a = samples_[begin + k];
+    const Lanes& b = samples_[begin + k + 1];
+    Lanes r;
+    for (int lane = 0; lane < 8; ++lane)
+        r.v[lane] = a.v[lane] + t * (b.v[lane] - a.v[lane]);
+    return r;
+}
+
+OpticalDepths LightSpaceCache::lookup(const Vec3f& p) const {
+    if (lineCount() == 0)
+        return {};
+    const Vec3f l = toLattice(p);
+    const float fi = std::floor(l.x), fj = std::floor(l.y);
+    const int i = static_cast<int>(fi), j = static_cast<int>(fj);
+    const float tx = l.x - fi, ty = l.y - fj;
+    Lanes r;
+    for (int k = 0; k < 4; ++k) {
+        const int ii = i + (k & 1), jj = j + (k >> 1);
+        if (ii < 0 || jj < 0 || ii >= ni_ || jj >= nj_)
+            continue;
+        const float w = ((k & 1) ? tx : 1.0f - tx) * ((k >> 1) ? ty : 1.0f - ty);
+        const Lanes s = alongLine(static_cast<std::size_t>(jj) * std::size_t(ni_) + std::size_t(ii), l.z);
+        for (int lane = 0; lane < 8; ++lane)
+            r.v[lane] += w * s.v[lane];
+    }
+    return r.depths();
+}
+
+std::size_t LightSpaceCache::memoryBytes() const {
+    return samples_.capacity() * sizeof(Lanes) + lineStart_.capacity() * sizeof(std::uint32_t) +
+           lineK0_.capacity() * sizeof(std::int32_t);
+}
+
+} // namespace hairvox::detail

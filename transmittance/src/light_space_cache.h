@@ -1,0 +1,60 @@
+// Internal to hairvox transmittance: the per-light cache of the grid modes.
+//
+// Shadow lines run through the rate volume toward the light: parallel to it
+// for a directional light (an orthographic lattice with the voxel spacing h),
+// or radiating from a point light that lies outside the volume's bounds (a
+// perspective lattice whose spacing is h at the volume's centre). Each line is
+// integrated exactly once, from the light side, and the running integral is
+// stored every h along it — only between the first brick it enters and the
+// point where it becomes opaque or leaves the volume (before: zero, after:
+// unchanged). A query interpolates its 4 surrounding lines bilinearly and
+// each line linearly along its length. No value is interpolated twice, so
+// there is no blur that grows with the path; the error is the lattice's
+// interpolation, about a voxel, as in the rate volume itself.
+#pragma once
+
+#include "brick_volume.h"
+
+#include <hairvox/transmittance/light_geometry.h>
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+namespace hairvox::detail {
+
+class LightSpaceCache {
+public:
+    /// Empty for a point light inside (or too close to) the volume's bounds,
+    /// where a perspective lattice cannot cover it: queries then march.
+    static std::optional<LightSpaceCache> build(const BrickVolume& rates,
+                                                const LightGeometry& light, float opaqueDepth);
+
+    /// The integral from p to the light.
+    OpticalDepths lookup(const Vec3f& p) const;
+
+    std::size_t lineCount() const { return lineStart_.size() - 1; }
+    std::size_t sampleCount() const { return samples_.size(); }
+    std::size_t memoryBytes() const;
+
+private:
+    /// Lattice coordinates of p: (u, v) across the lines, s along them (from the light).
+    Vec3f toLattice(const Vec3f& p) const;
+    /// A point of line (i, j) at lattice distance s.
+    Vec3f lineOrigin(int i, int j, Vec3f& dir) const;
+    /// The stored integral of line `line` at lattice distance s.
+    Lanes alongLine(std::size_t line, float s) const;
+
+    bool perspective_ = false;
+    Vec3f origin_{0.0f};                    ///< light position (perspective) or 0
+    Vec3f e1_{1, 0, 0}, e2_{0, 1, 0}, axis_{0, 0, 1}; ///< axis points away from the light
+    float du_ = 1;                          ///< lattice spacing across lines (world, or per unit depth)
+    float h_ = 1;                           ///< spacing along lines (world)
+    float sBase_ = 0;                       ///< world distance of lattice s = 0 from the light plane/point
+    int i0_ = 0, j0_ = 0, ni_ = 0, nj_ = 0; ///< line lattice [i0, i0 + ni) × [j0, j0 + nj)
+    std::vector<std::uint32_t> lineStart_;  ///< per line, offset of its first sample (+1 end)
+    std::vector<std::int32_t> lineK0_;      ///< per line, lattice index of its first sample
+    std::vector<Lanes> samples_;
+};
+
+} // namespace hairvox::detail
