@@ -43,11 +43,6 @@ GlobalTermSettings globalTermSettings(const Scene& scene) {
     return s;
 }
 
-LightGeometry lightGeometry(const Light& light) {
-    return light.kind == Light::Kind::Directional ? LightGeometry::directional(light.direction)
-                                                  : LightGeometry::point(light.position);
-}
-
 std::unique_ptr<SceneAssets> loadSceneAssets(const Scene& scene, const PipelineOptions& options) {
     auto assets = std::make_unique<SceneAssets>();
     auto start = Clock::now();
@@ -134,7 +129,7 @@ SceneRender renderScene(const Scene& scene, const PipelineOptions& options, bool
         if (!(light.intensity > 0) || light.color.isBlack()) {
             report.skipped = true;
         } else {
-            term = assets->globalTerm->forLight(lightGeometry(light));
+            term = assets->globalTerm->forLight(light);
             if (term->blocksEverything()) {
                 report.skipped = true;
                 term.reset();

@@ -209,12 +209,10 @@ Light parseLight(JsonObject obj, std::size_t index) {
         const Vec3f d = v.vec3(kCoordinate);
         if (!(glm::length(d) > 0))
             v.failExpected("a non-zero vector from the scene toward the light");
-        light.kind = Light::Kind::Directional;
-        light.direction = glm::normalize(d);
+        static_cast<LightGeometry&>(light) = LightGeometry::directional(d);
     } else {
-        light.kind = Light::Kind::Point;
-        light.position =
-            obj.required("position", "the light's position").vec3(kCoordinate);
+        static_cast<LightGeometry&>(light) = LightGeometry::point(
+            obj.required("position", "the light's position").vec3(kCoordinate));
     }
     if (const JsonValue v = obj["color"]; v.present())
         light.color = v.rgb(kLightColor);

@@ -25,11 +25,9 @@ struct Rendered {
 Rendered renderSmall() {
     Scene scene = test::testScene(80, 60, Vec3f(0.45f, 0.05f, -0.6f), Vec3f(0.0f, -0.1f, -0.05f));
     scene.head = Head{};
-    scene.lights.push_back(Light{"key", Light::Kind::Directional,
-                                 glm::normalize(Vec3f(0.6f, 0.7f, 0.4f)), Vec3f(0.0f), Rgb(1.0f),
+    scene.lights.push_back(Light{LightGeometry::directional(glm::normalize(Vec3f(0.6f, 0.7f, 0.4f))), "key", Rgb(1.0f),
                                  3.0f});
-    scene.lights.push_back(Light{"back", Light::Kind::Directional, Vec3f(0, 0, 1), Vec3f(0.0f),
-                                 Rgb(1.0f), 2.0f});
+    scene.lights.push_back(Light{LightGeometry::directional(Vec3f(0, 0, 1)), "back", Rgb(1.0f), 2.0f});
     scene.background = Rgb(0.02f, 0.03f, 0.04f);
     ProceduralGroomParams params;
     params.strands = 600;

@@ -203,8 +203,7 @@ TEST(RasterHead, HidesHairBehindItAndIsDrawn) {
     Scene scene = testScene(size, size, Vec3f(0, 0, 1), Vec3f(0, 0, 0));
     scene.fiberDiameter = 2e-3f;
     scene.head = Head{Sphere{Vec3f(0.0f), 0.1f}, Rgb(0.5f, 0.4f, 0.3f)};
-    scene.lights.push_back(Light{"key", Light::Kind::Directional, Vec3f(0, 0, 1), Vec3f(0.0f),
-                                 Rgb(1.0f), 2.0f});
+    scene.lights.push_back(Light{LightGeometry::directional(Vec3f(0, 0, 1)), "key", Rgb(1.0f), 2.0f});
     const test::ConstantShader shader;
     Groom groom;
     addStraightStrand(groom, Vec3f(-0.02f, 0.01f, -0.3f), Vec3f(0.02f, 0.01f, -0.3f), 4);
@@ -256,11 +255,9 @@ std::vector<unsigned char> filmBytes(const Film& film) {
 Scene groomScene(std::uint32_t size) {
     Scene scene = testScene(size, size, Vec3f(0.45f, 0.05f, -0.6f), Vec3f(0.0f, -0.1f, -0.05f));
     scene.head = Head{};
-    scene.lights.push_back(Light{"key", Light::Kind::Directional,
-                                 glm::normalize(Vec3f(0.6f, 0.7f, 0.4f)), Vec3f(0.0f), Rgb(1.0f),
+    scene.lights.push_back(Light{LightGeometry::directional(glm::normalize(Vec3f(0.6f, 0.7f, 0.4f))), "key", Rgb(1.0f),
                                  3.0f});
-    scene.lights.push_back(Light{"fill", Light::Kind::Point, Vec3f(0, 1, 0), Vec3f(-0.5f, 0.3f, -0.8f),
-                                 Rgb(0.5f, 0.6f, 1.0f), 0.2f});
+    scene.lights.push_back(Light{LightGeometry::point(Vec3f(-0.5f, 0.3f, -0.8f)), "fill", Rgb(0.5f, 0.6f, 1.0f), 0.2f});
     scene.background = Rgb(0.05f);
     return scene;
 }

@@ -11,35 +11,19 @@
 
 #include <hairvox/core/rgb.h>
 #include <hairvox/core/vecmath.h>
+#include <hairvox/transmittance/light_geometry.h>
 
-#include <limits>
 #include <ostream>
 #include <string>
 
 namespace hairvox {
 
-struct Light {
-    enum class Kind { Directional, Point };
-
+/// A scene light: where it is (LightGeometry, shared with the transmittance
+/// stage: kind, direction or position, pathFrom()) and what it emits.
+struct Light : LightGeometry {
     std::string name; ///< prefix of the light's AOV layers in the EXR ("key", "light1")
-    Kind kind = Kind::Directional;
-    Vec3f direction{0.0f, 1.0f, 0.0f}; ///< directional: unit ω_i, from the scene toward the light
-    Vec3f position{0.0f};              ///< point light position
     Rgb color{1.0f};        ///< each channel in [0, 1000]
     float intensity = 1.0f; ///< [0, 1e6]
-
-    struct Path {
-        Vec3f omega;    ///< unit ω_i from the point toward the light
-        float distance; ///< to the light; +∞ for a directional light
-    };
-    /// The shadow path from x (a point light at x itself: distance 0, ω = +y).
-    Path pathFrom(const Vec3f& x) const {
-        if (kind == Kind::Directional)
-            return {direction, std::numeric_limits<float>::infinity()};
-        const Vec3f d = position - x;
-        const float len = glm::length(d);
-        return len > 0 ? Path{d / len, len} : Path{Vec3f(0.0f, 1.0f, 0.0f), 0.0f};
-    }
 
     /// Irradiance at a point `distance` away (pathFrom), facing the light.
     Rgb irradiance(float distance) const;

@@ -54,8 +54,6 @@ std::unique_ptr<SceneAssets> loadSceneAssets(const Scene& scene, const PipelineO
 
 /// The global-term settings a scene implies (fiber scale, d_f, the head as occluder).
 GlobalTermSettings globalTermSettings(const Scene& scene);
-/// The transmittance stage's view of a scene light.
-LightGeometry lightGeometry(const Light& light);
 
 /// What happened to one light.
 struct LightReport {
