@@ -5,10 +5,13 @@
 
 namespace hairvox::cli {
 
+void addBenchCommand(CLI::App& app);
 void addGenerateCommand(CLI::App& app);
 void addInfoCommand(CLI::App& app);
+void addProbeCommand(CLI::App& app);
 void addRenderCommand(CLI::App& app);
 void addTablesCommand(CLI::App& app);
+void addTransmittanceCommand(CLI::App& app);
 void addVoxelizeCommand(CLI::App& app);
 
 } // namespace hairvox::cli

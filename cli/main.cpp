@@ -17,10 +17,13 @@ int main(int argc, char** argv) {
                  ": hair rendering with a voxel-grid dual-scattering global term"};
     app.set_version_flag("--version", std::string(HAIRVOX_VERSION));
     app.require_subcommand(1, 1);
+    hairvox::cli::addBenchCommand(app);
     hairvox::cli::addGenerateCommand(app);
     hairvox::cli::addInfoCommand(app);
+    hairvox::cli::addProbeCommand(app);
     hairvox::cli::addRenderCommand(app);
     hairvox::cli::addTablesCommand(app);
+    hairvox::cli::addTransmittanceCommand(app);
     hairvox::cli::addVoxelizeCommand(app);
     hairvox::installInterruptHandler();
 

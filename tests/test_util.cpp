@@ -42,7 +42,10 @@ void writeText(const std::filesystem::path& path, const std::string& text) {
 std::filesystem::path dataDir() { return HAIRVOX_DATA_DIR; }
 
 CommandResult runHairvox(const std::string& args) {
-    const std::string command = strCat("'", HAIRVOX_BINARY, "' ", args, " 2>&1");
+    return runShell(strCat("'", HAIRVOX_BINARY, "' ", args, " 2>&1"));
+}
+
+CommandResult runShell(const std::string& command) {
     FILE* pipe = ::popen(command.c_str(), "r");
     if (!pipe)
         throw std::runtime_error("popen failed: " + command);

@@ -57,5 +57,7 @@ struct CommandResult {
 
 /// Runs the hairvox executable with `args` (shell-quoted by the caller).
 CommandResult runHairvox(const std::string& args);
+/// Runs a shell command line; exit code 127 means "command not found".
+CommandResult runShell(const std::string& command);
 
 } // namespace hairvox::test

@@ -9,10 +9,13 @@
 #include <hairvox/strands/groom_io.h>
 #include <hairvox/voxelize/fiber_grid.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <string>
+#include <vector>
 
 namespace hairvox::cli {
 
@@ -39,7 +42,14 @@ void runVoxelize(const VoxelizeOptions& opt) {
     auto start = std::chrono::steady_clock::now();
     const LoadedGroom loaded = readGroom(opt.input);
     const double readSeconds = secondsSince(start);
-    for (const std::string& w : loaded.warnings)
+    std::vector<std::string> warnings = loaded.warnings;
+    if (loaded.sanitized.droppedSegments > 0)
+        warnings.push_back(
+            strCat("dropped ", loaded.sanitized.droppedSegments, " zero-length segment(s)"));
+    if (loaded.sanitized.droppedStrands > 0)
+        warnings.push_back(
+            strCat("dropped ", loaded.sanitized.droppedStrands, " strand(s) of coincident points"));
+    for (const std::string& w : warnings)
         std::fprintf(stderr, "hairvox: warning: %s: %s\n", opt.input.c_str(), w.c_str());
 
     SplatOptions splat;

@@ -43,23 +43,26 @@ GlobalTermSettings globalTermSettings(const Scene& scene) {
     return s;
 }
 
+Groom loadGroom(const Scene& scene, std::string& warnings) {
+    warnings.clear();
+    if (scene.groom.isProcedural())
+        return generateGroom(scene.groom.procedural);
+    LoadedGroom loaded = readGroom(scene.groom.file);
+    std::ostringstream os;
+    for (const std::string& w : loaded.warnings)
+        os << w << "; ";
+    if (loaded.sanitized.droppedSegments > 0)
+        os << "dropped " << loaded.sanitized.droppedSegments << " zero-length segment(s); ";
+    if (loaded.sanitized.droppedStrands > 0)
+        os << "dropped " << loaded.sanitized.droppedStrands << " degenerate strand(s); ";
+    warnings = os.str();
+    return std::move(loaded.groom);
+}
+
 std::unique_ptr<SceneAssets> loadSceneAssets(const Scene& scene, const PipelineOptions& options) {
     auto assets = std::make_unique<SceneAssets>();
     auto start = Clock::now();
-    if (scene.groom.isProcedural()) {
-        assets->groom = generateGroom(scene.groom.procedural);
-    } else {
-        LoadedGroom loaded = readGroom(scene.groom.file);
-        assets->groom = std::move(loaded.groom);
-        std::ostringstream warnings;
-        for (const std::string& w : loaded.warnings)
-            warnings << w << "; ";
-        if (loaded.sanitized.droppedSegments > 0)
-            warnings << "dropped " << loaded.sanitized.droppedSegments << " zero-length segment(s); ";
-        if (loaded.sanitized.droppedStrands > 0)
-            warnings << "dropped " << loaded.sanitized.droppedStrands << " degenerate strand(s); ";
-        assets->groomWarnings = warnings.str();
-    }
+    assets->groom = loadGroom(scene, assets->groomWarnings);
     assets->times.load = secondsSince(start);
     throwIfInterrupted();
 

@@ -48,6 +48,10 @@ struct SceneAssets {
     StageTimes times;                    ///< load, voxelize, tables
 };
 
+/// The scene's groom: generated, or read from its file. `warnings` receives
+/// what the reader dropped (empty when nothing).
+Groom loadGroom(const Scene& scene, std::string& warnings);
+
 /// Loads or generates the scene's groom and builds what its global-term mode needs.
 /// The result must not be moved while globalTerm is in use (it refers to grid).
 std::unique_ptr<SceneAssets> loadSceneAssets(const Scene& scene, const PipelineOptions& options);

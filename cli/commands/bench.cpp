@@ -1,0 +1,104 @@
+// hairvox bench [--scene FILE ...] [--out DIR] [--quick] [--threads N] [--runs N] [--no-scaling]
+// Sweeps global-term mode × voxel size × shading rate against exact-mode
+// references, then time and memory against segment count and image size
+// (render/bench_sweep.h); writes results.csv, results.md and PNG plots.
+// `hairvox bench --one JOB.json` is the worker that runs one job of a sweep in
+// its own process (so that its peak memory is its own).
+#include "../commands.h"
+
+#include <hairvox/core/error.h>
+#include <hairvox/render/bench_sweep.h>
+
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace hairvox::cli {
+
+namespace {
+
+struct BenchOptions {
+    std::vector<std::string> scenes;
+    std::string out = "bench";
+    bool quick = false;
+    int threads = 0;
+    std::optional<int> runs;
+    bool noScaling = false;
+    std::string job;
+};
+
+/// The command that regenerates the results, as recorded in results.md.
+std::string commandLine(const BenchOptions& opt) {
+    std::string line = "hairvox bench";
+    for (const std::string& s : opt.scenes)
+        line += " --scene " + s;
+    line += " --out " + opt.out;
+    if (opt.quick)
+        line += " --quick";
+    if (opt.threads > 0)
+        line += " --threads " + std::to_string(opt.threads);
+    if (opt.runs)
+        line += " --runs " + std::to_string(*opt.runs);
+    if (opt.noScaling)
+        line += " --no-scaling";
+    return line;
+}
+
+void runBench(const BenchOptions& opt) {
+    if (!opt.job.empty()) {
+        runBenchJobFile(opt.job);
+        return;
+    }
+    SweepOptions sweep = opt.quick ? SweepOptions::quick()
+                                   : SweepOptions::full("data/scenes/ratboy_mohawk.json");
+    if (!opt.scenes.empty()) {
+        sweep.scenes.clear();
+        for (const std::string& file : opt.scenes) {
+            BenchScene scene;
+            scene.file = std::filesystem::absolute(file);
+            scene.label = scene.file.stem().string();
+            sweep.scenes.push_back(scene);
+        }
+    }
+    if (opt.noScaling) {
+        sweep.segmentScaling.clear();
+        sweep.pixelScaling.clear();
+    }
+    if (opt.runs)
+        sweep.runs = *opt.runs;
+    sweep.threads = opt.threads;
+    sweep.outDir = opt.out;
+    sweep.workerCommand = {std::filesystem::read_symlink("/proc/self/exe").string(), "bench",
+                           "--one"};
+    sweep.commandLine = commandLine(opt);
+    sweep.log = &std::cout;
+    const SweepResult result = runSweep(sweep);
+    for (const auto& path : result.written)
+        std::cout << "wrote " << path.string() << "\n";
+}
+
+} // namespace
+
+void addBenchCommand(CLI::App& app) {
+    auto opt = std::make_shared<BenchOptions>();
+    CLI::App* cmd = app.add_subcommand(
+        "bench", "Benchmark: run time against error per mode, voxel size and shading rate, and "
+                 "how cost grows with segment count and image size");
+    cmd->add_option("--scene", opt->scenes,
+                    "Scene JSON file(s) to sweep instead of the default set (repeatable)");
+    cmd->add_option("-o,--out", opt->out, "Output directory (results.csv, results.md, PNG plots)");
+    cmd->add_flag("--quick", opt->quick,
+                  "A representative subset (2 scenes at 512², 3 voxel sizes, short scaling sweep)");
+    cmd->add_option("--threads", opt->threads, "Worker threads (0: all cores)")
+        ->check(CLI::Range(0, 1024));
+    cmd->add_option("--runs", opt->runs, "Timed renders per configuration (default 3)")
+        ->check(CLI::Range(1, 100));
+    cmd->add_flag("--no-scaling", opt->noScaling, "Skip the scaling sweep");
+    cmd->add_option("--one", opt->job, "Run one job of a sweep (internal)")->group("");
+    cmd->callback([opt] { runBench(*opt); });
+}
+
+} // namespace hairvox::cli
