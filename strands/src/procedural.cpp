@@ -139,7 +139,7 @@ std::vector<Vec3f> growCentreline(const HeadSphere& head, const Vec3f& rootDir, 
     const Vec3f comb = normalizeOr(combTarget - glm::dot(combTarget, rootDir) * rootDir, -kForward);
     Vec3f tilt(normalVariate(rng), normalVariate(rng), normalVariate(rng));
     tilt -= glm::dot(tilt, rootDir) * rootDir;
-    Vec3f dir = normalizeOr(comb + (0.35f + 0.2f * rng.uniformFloat()) * rootDir + 0.3f * tilt,
+    Vec3f dir = normalizeOr(comb + (0.15f + 0.15f * rng.uniformFloat()) * rootDir + 0.2f * tilt,
                             rootDir);
     // Bending rate towards −y, per unit length: stiffer hair falls later.
     const float bend = 2.5f / head.radius;
@@ -261,7 +261,7 @@ Groom generateGroom(const ProceduralGroomParams& params) {
             const Vec3f target = guide[k] + (line[0] - guide[0]) * (1.0f - u);
             line[k] = lerp(w, line[k], target);
         }
-        addStyleOffsets(line, params, looks[clump], 0.35f * normalVariate(rng));
+        addStyleOffsets(line, params, looks[clump], 0.15f * normalVariate(rng));
         for (Vec3f& p : line)
             p = head.pushOut(p, head.radius * 1.003f);
         groom.addStrand(line);

@@ -277,7 +277,7 @@ TEST(Scene, DefaultSceneIsTheShowcase) {
     EXPECT_EQ(s.groom.procedural.style, GroomStyle::Wavy);
     EXPECT_GE(s.groom.procedural.strands, 15000u);
     EXPECT_LE(s.groom.procedural.strands, 25000u);
-    EXPECT_EQ(s.fiber.sigma_a, Rgb(0.2f, 0.3f, 0.5f)); // light blond (DESIGN.md §3)
+    EXPECT_EQ(s.fiber.sigma_a, Rgb(0.12f, 0.2f, 0.4f)); // light blond (docs/scene.md)
     ASSERT_TRUE(s.head.has_value());
     EXPECT_GE(s.lights.size(), 2u);
     EXPECT_EQ(s.camera.width, 1024u);
