@@ -5,24 +5,26 @@
 
 namespace hairvox::detail {
 
-FileBytes::FileBytes(const std::filesystem::path& path, std::uint64_t maxBytes)
-    : name_(path.string()) {
+std::vector<unsigned char> readFileBytes(const std::filesystem::path& path,
+                                         std::uint64_t maxBytes) {
+    const std::string name = path.string();
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path, ec))
-        throw InputError(strCat(name_, ": no such file"));
+        throw InputError(strCat(name, ": no such file"));
     const std::uint64_t size = std::filesystem::file_size(path, ec);
     if (ec)
-        throw InputError(strCat(name_, ": cannot read size: ", ec.message()));
+        throw InputError(strCat(name, ": cannot read size: ", ec.message()));
     if (size > maxBytes)
-        throw InputError(strCat(name_, ": file is ", size, " bytes, more than the limit of ",
+        throw InputError(strCat(name, ": file is ", size, " bytes, more than the limit of ",
                                 maxBytes, " bytes for this format"));
     std::ifstream in(path, std::ios::binary);
     if (!in)
-        throw InputError(strCat(name_, ": cannot open for reading"));
-    bytes_.resize(size);
-    in.read(reinterpret_cast<char*>(bytes_.data()), static_cast<std::streamsize>(size));
+        throw InputError(strCat(name, ": cannot open for reading"));
+    std::vector<unsigned char> bytes(size);
+    in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(size));
     if (static_cast<std::uint64_t>(in.gcount()) != size)
-        throw InputError(strCat(name_, ": read error (file changed while reading?)"));
+        throw InputError(strCat(name, ": read error (file changed while reading?)"));
+    return bytes;
 }
 
 void FileBytes::checkRange(std::uint64_t offset, std::uint64_t count, std::uint64_t elementSize,

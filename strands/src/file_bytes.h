@@ -1,6 +1,6 @@
-// Internal to hairvox strands: a whole file in memory with bounds-checked,
-// overflow-safe little-endian reads. Every read names the file and the field
-// on failure, so readers never index past the end of what was read.
+// Internal to hairvox strands: a groom file's bytes in memory with
+// bounds-checked, overflow-safe little-endian reads. Every read names the file
+// and the field on failure, so readers never index past the end of what was read.
 #pragma once
 
 #include <hairvox/core/error.h>
@@ -9,8 +9,10 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <span>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace hairvox::detail {
@@ -18,14 +20,19 @@ namespace hairvox::detail {
 static_assert(std::endian::native == std::endian::little,
               "the binary groom readers assume a little-endian host");
 
+/// Reads the whole file; refuses files over `maxBytes`.
+std::vector<unsigned char> readFileBytes(const std::filesystem::path& path,
+                                         std::uint64_t maxBytes);
+
+/// A view of a file's bytes (which must outlive it) named for error messages.
 class FileBytes {
 public:
-    /// Reads the whole file; refuses files over `maxBytes`.
-    FileBytes(const std::filesystem::path& path, std::uint64_t maxBytes);
+    FileBytes(std::span<const unsigned char> bytes, std::string name)
+        : name_(std::move(name)), bytes_(bytes) {}
 
     const std::string& name() const { return name_; }
     std::uint64_t size() const { return bytes_.size(); }
-    const std::vector<unsigned char>& bytes() const { return bytes_; }
+    std::span<const unsigned char> bytes() const { return bytes_; }
 
     template <typename T>
         requires std::is_trivially_copyable_v<T>
@@ -53,7 +60,7 @@ public:
 
 private:
     std::string name_;
-    std::vector<unsigned char> bytes_;
+    std::span<const unsigned char> bytes_;
 };
 
 } // namespace hairvox::detail

@@ -47,8 +47,14 @@ constexpr float kDefaultThicknessMetres = 1e-4f;
 
 LoadedGroom readHairFile(const std::filesystem::path& path, const GroomReadOptions& options) {
     // At most 34 bytes per point: 8 floats of arrays and a segment count.
-    const detail::FileBytes file(path, sizeof(HairHeader) + 34 * options.maxPoints);
-    const std::string& name = file.name();
+    const std::vector<unsigned char> bytes =
+        detail::readFileBytes(path, sizeof(HairHeader) + 34 * options.maxPoints);
+    return parseHairBytes(bytes, path.string(), options);
+}
+
+LoadedGroom parseHairBytes(std::span<const unsigned char> bytes, const std::string& name,
+                           const GroomReadOptions& options) {
+    const detail::FileBytes file(bytes, name);
     if (file.size() < sizeof(HairHeader))
         throw InputError(strCat(name, ": truncated header: ", file.size(),
                                 " bytes, a .hair header is 128"));

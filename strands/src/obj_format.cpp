@@ -143,13 +143,17 @@ private:
 
 LoadedGroom readObjFile(const std::filesystem::path& path, const GroomReadOptions& options) {
     // A vertex record is at least 8 bytes ("v 0 0 0\n"): the point limit bounds the file.
-    const detail::FileBytes file(path, 64 * options.maxPoints);
-    const auto& bytes = file.bytes();
+    const std::vector<unsigned char> bytes = detail::readFileBytes(path, 64 * options.maxPoints);
+    return parseObjBytes(bytes, path.string(), options);
+}
+
+LoadedGroom parseObjBytes(std::span<const unsigned char> bytes, const std::string& name,
+                          const GroomReadOptions& options) {
     const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
     if (text.find('\0') != std::string_view::npos)
-        throw InputError(strCat(file.name(), ": not an OBJ text file (contains NUL bytes)"));
+        throw InputError(strCat(name, ": not an OBJ text file (contains NUL bytes)"));
 
-    ObjParser parser(file.name(), options);
+    ObjParser parser(name, options);
     std::uint64_t lineNumber = 0;
     for (std::size_t pos = 0; pos < text.size();) {
         std::size_t end = text.find('\n', pos);
@@ -159,7 +163,7 @@ LoadedGroom readObjFile(const std::filesystem::path& path, const GroomReadOption
         pos = end + 1;
     }
     LoadedGroom loaded = parser.finish();
-    loaded.sanitized = sanitizeGroom(loaded.groom, file.name());
+    loaded.sanitized = sanitizeGroom(loaded.groom, name);
     return loaded;
 }
 

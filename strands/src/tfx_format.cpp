@@ -37,8 +37,14 @@ struct Float4 {
 
 LoadedGroom readTfxFile(const std::filesystem::path& path, const GroomReadOptions& options) {
     // Offsets are 32-bit, so a valid file is under 4 GiB plus its last array.
-    const detail::FileBytes file(path, sizeof(TfxHeader) + 40 * options.maxPoints);
-    const std::string& name = file.name();
+    const std::vector<unsigned char> bytes =
+        detail::readFileBytes(path, sizeof(TfxHeader) + 40 * options.maxPoints);
+    return parseTfxBytes(bytes, path.string(), options);
+}
+
+LoadedGroom parseTfxBytes(std::span<const unsigned char> bytes, const std::string& name,
+                          const GroomReadOptions& options) {
+    const detail::FileBytes file(bytes, name);
     if (file.size() < sizeof(TfxHeader))
         throw InputError(strCat(name, ": truncated header: ", file.size(),
                                 " bytes, a TressFX header is 160"));

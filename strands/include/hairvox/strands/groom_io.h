@@ -13,6 +13,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <span>
 #include <string>
 
 namespace hairvox {
@@ -42,6 +43,15 @@ LoadedGroom readGroom(const std::filesystem::path& path, const GroomReadOptions&
 LoadedGroom readHairFile(const std::filesystem::path& path, const GroomReadOptions& options = {});
 LoadedGroom readTfxFile(const std::filesystem::path& path, const GroomReadOptions& options = {});
 LoadedGroom readObjFile(const std::filesystem::path& path, const GroomReadOptions& options = {});
+
+/// The same readers on a file's bytes already in memory (the read*File
+/// functions read the file and call these); `name` prefixes error messages.
+LoadedGroom parseHairBytes(std::span<const unsigned char> bytes, const std::string& name,
+                           const GroomReadOptions& options = {});
+LoadedGroom parseTfxBytes(std::span<const unsigned char> bytes, const std::string& name,
+                          const GroomReadOptions& options = {});
+LoadedGroom parseObjBytes(std::span<const unsigned char> bytes, const std::string& name,
+                          const GroomReadOptions& options = {});
 
 /// Writes a .hair file atomically, with the optional arrays the groom has.
 /// Throws InputError if a strand has more than 65,535 segments (the format's limit).
