@@ -105,10 +105,14 @@ std::uint64_t JsonValue::integer(std::uint64_t lo, std::uint64_t hi) const {
         if (x >= 0 && std::uint64_t(x) >= lo && std::uint64_t(x) <= hi)
             return std::uint64_t(x);
     } else if (value_->is_number_float()) {
-        // 2e4 is a fine way to write 20000.
+        // 2e4 is a fine way to write 20000. double(hi) rounds up to 2^64 for
+        // hi = 2^64 - 1, and converting 2^64 is undefined: compare as integers.
         const double x = value_->get<double>();
-        if (x == std::floor(x) && x >= double(lo) && x <= double(hi))
-            return static_cast<std::uint64_t>(x);
+        if (x == std::floor(x) && x >= 0 && x < 0x1p64) {
+            const auto n = static_cast<std::uint64_t>(x);
+            if (n >= lo && n <= hi)
+                return n;
+        }
     }
     failExpected(what);
 }

@@ -418,8 +418,9 @@ Scene parseSceneText(std::string_view text, const std::string& sourceName,
     nlohmann::json document;
     try {
         document = nlohmann::json::parse(text.begin(), text.end());
-    } catch (const nlohmann::json::parse_error& e) {
-        // e.what() reads "[json.exception.parse_error.101] parse error at line 3, column 5: ...".
+    } catch (const nlohmann::json::exception& e) {
+        // e.what() reads "[json.exception.parse_error.101] parse error at line 3, column 5: ...";
+        // a number too large for a double is an out_of_range.406 from the parser.
         const std::string what = e.what();
         const std::size_t at = what.find("] ");
         throw InputError(strCat(sourceName, ": invalid JSON: ",

@@ -247,6 +247,35 @@ TEST(Scene, HostileDocumentsGiveErrorsNotCrashes) {
     EXPECT_LT(errorOf(j).size(), 300u);
 }
 
+// Regression (issue 8, malformed-input corpus): nlohmann::json reports a
+// number beyond double range as out_of_range, not parse_error; it escaped as an
+// internal error (exit code 1).
+TEST(Scene, NumberBeyondDoubleRangeIsAnInputError) {
+    try {
+        parseSceneText("{\"background\": [1e400, 0, 0]}", "big.json", "/");
+        FAIL() << "no error";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("big.json: invalid JSON: number overflow"),
+                  std::string::npos)
+            << e.what();
+    }
+}
+
+// Regression (issue 8, fuzzing with UBSan): an integer beyond uint64 (2^64
+// parses as a double) was converted to uint64 before the range check failed —
+// undefined behaviour (found by review, confirmed by fuzz_scene under UBSan).
+TEST(Scene, IntegerBeyondUint64IsAnInputError) {
+    nlohmann::json j = validScene();
+    j["groom"]["procedural"]["seed"] = nlohmann::json::parse("18446744073709551616");
+    EXPECT_NE(errorOf(j).find("/groom/procedural/seed: expected an integer in [0, 18446744073709551615]"),
+              std::string::npos)
+        << errorOf(j);
+    j["groom"]["procedural"]["seed"] = 1e19; // an integral double within range
+    EXPECT_EQ(errorOf(j), "");
+    j["groom"]["procedural"]["seed"] = -1.0;
+    EXPECT_NE(errorOf(j).find("/groom/procedural/seed"), std::string::npos);
+}
+
 TEST(Scene, LoadsFilesAndResolvesGroomPathsAgainstTheSceneFile) {
     test::TempDir dir;
     nlohmann::json j = validScene();
