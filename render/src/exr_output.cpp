@@ -1,5 +1,6 @@
 #include <hairvox/core/atomic_file.h>
 #include <hairvox/core/error.h>
+#include <hairvox/core/interrupt.h>
 #include <hairvox/core/parallel.h>
 #include <hairvox/render/output.h>
 
@@ -149,10 +150,13 @@ void writeExr(const std::filesystem::path& path, const Film& film, const Camera&
         try {
             Imf::OutputFile file(tmp.c_str(), header, threads);
             for (int y = 0; y < film.height; y += kBandRows) {
+                throwIfInterrupted(); // a large image with many AOVs takes seconds to compress
                 const int rows = std::min(kBandRows, film.height - y);
                 layout.setBand(file, y, rows);
                 file.writePixels(rows);
             }
+        } catch (const Interrupted&) {
+            throw;
         } catch (const std::exception& e) {
             throw InputError(strCat(path.string(), ": cannot write OpenEXR file: ", e.what()));
         }

@@ -2,6 +2,7 @@
 #include "test_util.h"
 
 #include <hairvox/core/error.h>
+#include <hairvox/core/interrupt.h>
 #include <hairvox/core/parallel.h>
 #include <hairvox/render/output.h>
 #include <hairvox/render/render.h>
@@ -166,6 +167,27 @@ TEST(Output, FailedWritesLeaveNoFileAndKeepTheOldOne) {
         ++files;
     EXPECT_EQ(files, 1); // no temporary left behind
     EXPECT_THROW(readExr(dir / "keep.png"), InputError);
+}
+
+// Regression (issue 8, Ctrl-C latency): the EXR writer polls for interruption
+// between bands and lets Interrupted through (it used to become an InputError
+// naming the file, and a 1024² image compressed for seconds after Ctrl-C).
+TEST(Output, InterruptedExrWriteLeavesTheOldFile) {
+    const Rendered r = renderSmall();
+    test::TempDir dir;
+    const auto path = dir / "keep.exr";
+    test::writeText(path, "previous image");
+    requestInterrupt();
+    EXPECT_THROW(writeExr(path, r.film, Camera(r.scene.camera), {}), Interrupted);
+    clearInterrupt();
+    std::ifstream in(path);
+    std::string text;
+    std::getline(in, text);
+    EXPECT_EQ(text, "previous image");
+    int files = 0;
+    for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator(dir.path()))
+        ++files;
+    EXPECT_EQ(files, 1); // no temporary left behind
 }
 
 } // namespace
