@@ -51,6 +51,9 @@ void GridOptions::validate(const FiberGrid& grid) const {
     if (!(startOffset >= 0 && startOffset <= 8))
         throw InputError(strCat("grid start offset = ", startOffset,
                                 " voxels should be in the range [0, 8]"));
+    if (!(cacheSpacing >= 0.5f && cacheSpacing <= 4))
+        throw InputError(strCat("grid cache spacing = ", cacheSpacing,
+                                " voxels should be in the range [0.5, 4]"));
     if (orientation == OrientationModel::Tensor && !grid.hasTensor())
         throw InputError("the tensor orientation model needs a fiber grid with the orientation "
                          "tensor (voxelize --orientation-tensor)");
@@ -62,7 +65,8 @@ std::ostream& operator<<(std::ostream& os, const GridOptions& options) {
     return os << "GridOptions(orientation=" << toString(options.orientation)
               << ", estimator=" << toString(options.estimator)
               << ", evaluation=" << toString(options.evaluation)
-              << ", startOffset=" << options.startOffset << " voxels)";
+              << ", startOffset=" << options.startOffset
+              << " voxels, cacheSpacing=" << options.cacheSpacing << " voxels)";
 }
 
 namespace {
@@ -158,27 +162,27 @@ BrickVolume GridModel::buildRates(const LightGeometry& light) const {
     const float kD = settings_.densityMultiplier * settings_.fiberDiameter;
     const bool tensor = options_.orientation == OrientationModel::Tensor;
     const bool poisson = options_.estimator == AttenuationEstimator::Poisson;
+    // The orientation grids share the density's topology: read them leaf by leaf.
+    const auto vec = [](const openvdb::Vec3s& v) { return Vec3f(v.x(), v.y(), v.z()); };
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size(), 4), [&](const auto& range) {
-        auto orientation = grid_.orientation->getConstAccessor();
-        auto diag = tensor ? grid_.tensorDiag->getConstAccessor() : orientation;
-        auto offDiag = tensor ? grid_.tensorOffDiag->getConstAccessor() : orientation;
         for (std::size_t li = range.begin(); li != range.end(); ++li) {
             const LeafT& leaf = *leaves[li];
+            const openvdb::Coord origin = leaf.origin();
+            const auto* orientation = grid_.orientation->tree().probeConstLeaf(origin);
+            const auto* diag = tensor ? grid_.tensorDiag->tree().probeConstLeaf(origin) : nullptr;
+            const auto* offDiag = tensor ? grid_.tensorOffDiag->tree().probeConstLeaf(origin) : nullptr;
             const BrickVolume::BrickSet bricks = volume.brickSet(brickOf(leaf));
             for (auto it = leaf.cbeginValueOn(); it; ++it) {
+                const openvdb::Index i = it.pos();
+                VoxelFibers fibers{*it, orientation ? vec(orientation->getValue(i)) : Vec3f(0.0f),
+                                   diag ? vec(diag->getValue(i)) : Vec3f(0.0f),
+                                   offDiag ? vec(offDiag->getValue(i)) : Vec3f(0.0f)};
                 const openvdb::Coord c = it.getCoord();
-                const auto toVec = [](const openvdb::Vec3s& v) { return Vec3f(v.x(), v.y(), v.z()); };
-                VoxelFibers fibers{*it, toVec(orientation.getValue(c)), Vec3f(0.0f), Vec3f(0.0f)};
-                if (tensor) {
-                    fibers.tensorDiag = toVec(diag.getValue(c));
-                    fibers.tensorOffDiag = toVec(offDiag.getValue(c));
-                }
                 const Vec3f world = Vec3f(float(c.x()), float(c.y()), float(c.z())) * float(h);
-                const Vec3f omega = light.pathFrom(world).omega;
-                const CrossingTable::Rates r =
-                    expectedRates(fibers, omega, crossings_, options_.orientation);
+                const CrossingTable::Rates r = expectedRates(fibers, light.pathFrom(world).omega,
+                                                             crossings_, options_.orientation);
                 const float scale = fibers.lambda * kD;
-                const openvdb::Coord l = c - leaf.origin();
+                const openvdb::Coord l = c - origin;
                 volume.set(bricks, {l.x(), l.y(), l.z()},
                            {scale * r.cosTheta, (poisson ? r.wAbsorb : r.wLogA) * scale,
                             r.wBeta2 * scale});
@@ -193,7 +197,8 @@ public:
     GridLightGlobalTerm(const GridModel& model, const LightGeometry& light)
         : model_(model), light_(light), rates_(model.buildRates(light)) {
         if (model.options().evaluation == GridEvaluation::Cache)
-            cache_ = LightSpaceCache::build(rates_, light, kOpaqueDepth);
+            cache_ = LightSpaceCache::build(rates_, light, kOpaqueDepth,
+                                            model.options().cacheSpacing);
     }
 
     GlobalTermStats evaluate(std::span<const GlobalTermQuery> queries,

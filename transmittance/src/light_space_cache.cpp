@@ -25,7 +25,7 @@ std::array<Vec3f, 8> corners(const Bounds3f& b) {
 
 std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates,
                                                       const LightGeometry& light,
-                                                      float opaqueDepth) {
+                                                      float opaqueDepth, float spacing) {
     LightSpaceCache cache;
     cache.h_ = static_cast<float>(rates.voxelSize());
     const Bounds3f bounds = rates.bounds();
@@ -39,7 +39,7 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates,
     if (light.kind == LightGeometry::Kind::Directional) {
         cache.axis_ = -light.direction;
         coordinateSystem(cache.axis_, cache.e1_, cache.e2_);
-        cache.du_ = cache.h_;
+        cache.du_ = spacing * cache.h_;
         float sMin = std::numeric_limits<float>::infinity();
         sMaxWorld = -sMin;
         for (const Vec3f& c : boxCorners) {
@@ -68,7 +68,7 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates,
         }
         const Vec3f nearest = glm::clamp(light.position, bounds.min, bounds.max);
         sMin = glm::distance(nearest, light.position);
-        cache.du_ = cache.h_ / glm::dot(toCentre, cache.axis_);
+        cache.du_ = spacing * cache.h_ / glm::dot(toCentre, cache.axis_);
         cache.sBase_ = std::max(sMin - cache.h_, 0.0f);
     }
 

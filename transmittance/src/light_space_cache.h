@@ -27,8 +27,10 @@ class LightSpaceCache {
 public:
     /// Empty for a point light inside (or too close to) the volume's bounds,
     /// where a perspective lattice cannot cover it: queries then march.
+    /// `spacing` is the distance between lines in voxels (along them: one voxel).
     static std::optional<LightSpaceCache> build(const BrickVolume& rates,
-                                                const LightGeometry& light, float opaqueDepth);
+                                                const LightGeometry& light, float opaqueDepth,
+                                                float spacing);
 
     /// The integral from p to the light.
     OpticalDepths lookup(const Vec3f& p) const;

@@ -21,11 +21,12 @@
 //    (random access to the volume): fine for probes, slow for a frame.
 //  - cache (default): forLight() first integrates shadow lines through the
 //    volume, once each and exactly — parallel to a directional light, or
-//    radiating from a point light outside the volume — one line per voxel
-//    spacing, storing the running integral every voxel along it. A query
+//    radiating from a point light outside the volume — `cacheSpacing` voxels
+//    apart, storing the running integral every voxel along each. A query
 //    interpolates 4 lines (a point light inside the volume falls back to march).
-//    The interpolation between lines is about a voxel wide, like the volume's
-//    own reconstruction; the error against exact mode is measured in the tests.
+//    Measured on the 1.4M-segment wavy groom against exact (K = 256): spacing
+//    1 / 1.5 / 2 voxels gives MAE(V) 0.0087 / 0.0094 / 0.0102 for a build of
+//    1.7 / 1.0 / 0.76 s per light (2 loaded cores): 1.5 is the default.
 //
 // Self-shadowing: the query point's own fiber is splatted into the voxels
 // around it; the integral starts `startOffset` voxels toward the light to leave
@@ -75,6 +76,7 @@ struct GridOptions {
     AttenuationEstimator estimator = AttenuationEstimator::Poisson;
     GridEvaluation evaluation = GridEvaluation::Cache;
     float startOffset = 0.0f; ///< voxels toward the light before integrating, [0, 8]
+    float cacheSpacing = 1.5f; ///< voxels between the cache's shadow lines, [0.5, 4]
 
     void validate(const FiberGrid& grid) const;
 };
