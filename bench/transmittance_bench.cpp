@@ -14,6 +14,9 @@
 //   FrameGlobalTerm/N   forLight + N queries: N = shading points of the 1080p
 //                       render of this groom (4.15M at fragment rate, 0.62M at
 //                       vertex rate; from render_bench)
+//   ProbeAccuracy       MAE of V and T_s of grid and approx against exact with
+//                       K = 256 rays over a disk of one voxel, 300 points on the
+//                       fibers, three lights (issue 5: ≤ 0.03 and ≤ 0.02)
 #include <hairvox/core/parallel.h>
 #include <hairvox/shading/dual_scattering_tables.h>
 #include <hairvox/strands/procedural.h>
@@ -119,6 +122,36 @@ void FrameGlobalTerm(benchmark::State& state) {
     state.counters["queries"] = double(count);
 }
 BENCHMARK(FrameGlobalTerm)->Arg(4'150'000)->Arg(619'000)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+
+void ProbeAccuracy(benchmark::State& state) {
+    const Fixture& f = Fixture::get();
+    const std::vector<GlobalTermQuery> points = sampleFiberPoints(f.groom, 300, 7);
+    ExactOptions exactOptions;
+    exactOptions.rays = 256;
+    exactOptions.radius = static_cast<float>(f.grid.info.voxelSize);
+    const auto exact = makeExactModel(f.groom, f.crossings, f.settings, exactOptions);
+    const auto grid = makeGridModel(f.grid, f.crossings, f.settings, {});
+    const auto approx = makeApproxModel(f.grid, f.crossings, f.settings, {});
+    const Vec3f lights[3] = {Vec3f(0.3f, 1, 0.4f), Vec3f(1, 0.2f, -0.3f), Vec3f(-0.2f, 0.3f, -1)};
+    for (auto _ : state) {
+        ProbeError g, a;
+        for (const Vec3f& l : lights) {
+            const LightGeometry light = LightGeometry::directional(l);
+            const std::vector<GlobalTerm> reference = evaluateGlobalTerm(*exact, light, points);
+            const ProbeError eg = compareGlobalTerms(evaluateGlobalTerm(*grid, light, points), reference);
+            const ProbeError ea = compareGlobalTerms(evaluateGlobalTerm(*approx, light, points), reference);
+            g.maeV += eg.maeV / 3;
+            g.maeT_s += eg.maeT_s / 3;
+            a.maeV += ea.maeV / 3;
+            a.maeT_s += ea.maeT_s / 3;
+        }
+        state.counters["grid_MAE_V"] = g.maeV;
+        state.counters["grid_MAE_Ts"] = g.maeT_s;
+        state.counters["approx_MAE_V"] = a.maeV;
+        state.counters["approx_MAE_Ts"] = a.maeT_s;
+    }
+}
+BENCHMARK(ProbeAccuracy)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 
 } // namespace
 } // namespace hairvox
