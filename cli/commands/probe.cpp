@@ -31,6 +31,7 @@ struct ProbeOptions {
     std::optional<std::uint32_t> rays;
     std::optional<float> radius;
     std::optional<std::size_t> samplePoints;
+    std::string evaluation = "auto";
     std::uint64_t seed = 1;
     int threads = 0;
 };
@@ -64,6 +65,11 @@ void runProbe(const ProbeOptions& opt) {
     const auto start = std::chrono::steady_clock::now();
     PipelineOptions options;
     options.threads = opt.threads;
+    // A grid-mode cache costs a fixed ~0.1–1 s per light; a march ~20–40 µs per
+    // point (transmittance_bench): below ~20,000 points marching is faster.
+    const bool march = opt.evaluation == "march" ||
+                       (opt.evaluation == "auto" && points.size() < 20'000);
+    options.grid.evaluation = march ? GridEvaluation::March : GridEvaluation::Cache;
     const std::unique_ptr<SceneAssets> assets = loadSceneAssets(scene, options);
     const auto evaluateStart = std::chrono::steady_clock::now();
     const std::vector<GlobalTerm> terms = evaluateGlobalTerm(*assets->globalTerm, light, points);
@@ -100,6 +106,11 @@ void addProbeCommand(CLI::App& app) {
     cmd->add_option("--mode", opt->mode, "Global-term mode")
         ->capture_default_str()
         ->check(CLI::IsMember({"exact", "grid", "approx"}));
+    cmd->add_option("--evaluation", opt->evaluation,
+                    "Grid/approx: per-light cache or one march per point (auto: march below "
+                    "20,000 points)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"auto", "cache", "march"}));
     cmd->add_option("--rays", opt->rays, "Exact mode: rays per point K [1, 65536]");
     cmd->add_option("--radius", opt->radius,
                     "Exact mode: ray origins spread over a disk of this radius");

@@ -97,6 +97,16 @@ TEST(RenderPipeline, NoLightGivesBlackHair) {
     EXPECT_GT(hairAlpha, 10.0); // the hair is there, and black
 }
 
+TEST(RenderPipeline, LightInsideTheHeadIsSkipped) {
+    test::TempDir dir;
+    Scene scene = smallScene(dir);
+    static_cast<LightGeometry&>(scene.lights[1]) = LightGeometry::point(Vec3f(0.0f, 0.02f, 0.0f));
+    const SceneRender r = renderScene(scene, options(dir), false);
+    EXPECT_FALSE(r.lights[0].skipped);
+    EXPECT_TRUE(r.lights[1].skipped);
+    EXPECT_EQ(r.lights[1].stats.queries, 0u); // never evaluated
+}
+
 TEST(RenderPipeline, HeadShadowsTheHairBehindIt) {
     // Strands between the camera and the head, lit only from behind the head:
     // the head blocks every shadow ray, so the hair gets no light at all.

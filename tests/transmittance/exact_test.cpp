@@ -186,3 +186,24 @@ TEST(ExactGlobalTerm, IndependentOfBatchingAndOrder) {
 
 } // namespace
 } // namespace hairvox
+
+namespace hairvox {
+namespace {
+
+TEST(GlobalTermOccluder, PointLightInsideTheHeadReachesNothing) {
+    const test::Slab slab;
+    GlobalTermSettings s = settings();
+    s.occluder = Sphere{Vec3f(0, 0.05f, 0), 0.01f};
+    const auto model = makeExactModel(slab.groom(), constantTable(0.5f, 0.01f), s, {});
+    EXPECT_TRUE(model->forLight(LightGeometry::point(Vec3f(0, 0.052f, 0)))->blocksEverything());
+    EXPECT_FALSE(model->forLight(LightGeometry::point(Vec3f(0, 0.1f, 0)))->blocksEverything());
+    EXPECT_FALSE(model->forLight(LightGeometry::directional(Vec3f(0, 1, 0)))->blocksEverything());
+    s.occluder.reset();
+    EXPECT_FALSE(
+        makeExactModel(slab.groom(), constantTable(0.5f, 0.01f), s, {})
+            ->forLight(LightGeometry::point(Vec3f(0, 0.052f, 0)))
+            ->blocksEverything());
+}
+
+} // namespace
+} // namespace hairvox
