@@ -425,6 +425,20 @@ TEST(Splat, RefusesAVoxelSizeOverTheMemoryBudgetStatingTheEstimate) {
     EXPECT_NO_THROW(splatStrands(groom, small));
 }
 
+TEST(Splat, AcceptsFineVoxelsThatFitTheBudget) {
+    // At 700 voxels across, the leaves of the bounding box alone would need
+    // ~2 GiB; the hair of 1,000 strands needs far less and fits 1 GiB.
+    ProceduralGroomParams p;
+    p.strands = 1000;
+    const Groom groom = generateGroom(p);
+    SplatOptions o = withVoxelSize(defaultVoxelSize(groom, 700));
+    o.memoryBudgetBytes = 1ull << 30;
+    const FiberGrid g = splatStrands(groom, o);
+    EXPECT_LT(g.memoryBytes(), o.memoryBudgetBytes / 2);
+    o.memoryBudgetBytes = g.memoryBytes() / 4;
+    EXPECT_THROW(splatStrands(groom, o), InputError);
+}
+
 TEST(Splat, RefusesCoordinatesBeyondTheIndexSpace) {
     const Groom far = groomOf({{{1e6f, 0, 0}, {1e6f + 1, 0, 0}}});
     EXPECT_THROW(splatStrands(far, withVoxelSize(1e-4)), InputError);

@@ -708,17 +708,31 @@ double voxelSizeFromBounds(const Bounds3f& bounds, int voxelsAcross) {
     return longest > 0 ? longest / voxelsAcross : 1.0;
 }
 
-struct MemoryEstimate {
-    double leaves = 0, bytes = 0;
-};
+/// Bytes splatStrands needs for `leaves` leaf nodes in each grid, plus the
+/// runs of the bucketing (about one per strand and brick crossing, doubled
+/// for the bricks above that need a brick's last layer) and the accumulators.
+double memoryForLeaves(double leaves, const Groom& groom, const GroomScan& scan, double h,
+                       bool tensor, bool threaded) {
+    const double leafBytes =
+        double(sizeof(FloatLeaf) + FloatLeaf::SIZE * sizeof(float)) +
+        double(tensor ? 3 : 1) *
+            double(sizeof(Vec3SLeaf) + Vec3SLeaf::SIZE * sizeof(openvdb::Vec3s));
+    const double l1 = scan.sumAbsDelta.x + scan.sumAbsDelta.y + scan.sumAbsDelta.z;
+    const double runs = 2.0 * (double(groom.strandCount()) + l1 / (h * kBrickSize));
+    const double accumulatorBytes = double(kAccDim) * kAccDim * kAccDim * (tensor ? 10 : 4) * 8;
+    const double threads = threaded ? std::max(1, activeThreadCount()) : 1;
+    return leaves * leafBytes + runs * double(sizeof(ChunkRuns::Entry) + sizeof(Run)) +
+           threads * accumulatorBytes;
+}
 
-/// Leaves: a segment crosses on average Σ|Δ|/(8h) leaf boundaries; each
-/// strand touches about one leaf per crossing plus one, times (9/8)³ for the
-/// trilinear corners that spill into the next leaf, and never more leaves than
-/// the bounding box holds. Bucketing: about one run per strand and brick
-/// crossing, doubled for the bricks above that need a brick's last layer.
-MemoryEstimate estimateMemory(const Groom& groom, const GroomScan& scan, double h, bool tensor,
-                              bool threaded) {
+/// Trilinear corners spill into the next leaf on each axis for 1 cell in 8.
+constexpr double kLeafSpill = (9.0 / 8.0) * (9.0 / 8.0) * (9.0 / 8.0);
+
+/// A quick bound on the leaves the grids will hold: the leaves of the
+/// bounding box, or, if fewer, one per strand plus one per leaf boundary
+/// crossed (Σ|Δ|₁ / 8h) with spill. Both ignore that hair is a shell and
+/// that strands share leaves, so it can be several times too high.
+double leafBound(const Groom& groom, const GroomScan& scan, double h) {
     double boxLeaves = 1;
     for (int i = 0; i < 3; ++i) {
         const double leafSize = h * kLeafDim;
@@ -726,20 +740,41 @@ MemoryEstimate estimateMemory(const Groom& groom, const GroomScan& scan, double 
                      std::floor(double(scan.bounds.min[i]) / leafSize) + 2;
     }
     const double l1 = scan.sumAbsDelta.x + scan.sumAbsDelta.y + scan.sumAbsDelta.z;
-    const auto strands = double(groom.strandCount());
-    constexpr double spill = (9.0 / 8.0) * (9.0 / 8.0) * (9.0 / 8.0);
-    MemoryEstimate e;
-    e.leaves = std::min(boxLeaves, (strands + l1 / (h * kLeafDim)) * spill);
-    const double leafBytes =
-        double(sizeof(FloatLeaf) + FloatLeaf::SIZE * sizeof(float)) +
-        double(tensor ? 3 : 1) *
-            double(sizeof(Vec3SLeaf) + Vec3SLeaf::SIZE * sizeof(openvdb::Vec3s));
-    const double runs = 2.0 * (strands + l1 / (h * kBrickSize));
-    const double accumulatorBytes = double(kAccDim) * kAccDim * kAccDim * (tensor ? 10 : 4) * 8;
-    const double threads = threaded ? std::max(1, activeThreadCount()) : 1;
-    e.bytes = e.leaves * leafBytes + runs * double(sizeof(ChunkRuns::Entry) + sizeof(Run)) +
-              threads * accumulatorBytes;
-    return e;
+    return std::min(boxLeaves, (double(groom.strandCount()) + l1 / (h * kLeafDim)) * kLeafSpill);
+}
+
+/// A closer estimate of the leaves, for when leafBound() is over the budget:
+/// the distinct leaves of points sampled along every segment at most one leaf
+/// apart per axis, with spill. Costs one sort of the samples.
+double sampledLeafCount(const Groom& groom, const std::vector<StrandRange>& chunks, double h,
+                        bool threaded) {
+    const double invLeaf = 1.0 / (h * kLeafDim);
+    const BrickKeyHash hash; // of leaf coordinates here; a collision only lowers the count
+    std::vector<std::vector<std::uint64_t>> perChunk(chunks.size());
+    forEachIndex(chunks.size(), threaded, [&](std::size_t c) {
+        throwIfInterrupted();
+        std::vector<std::uint64_t>& keys = perChunk[c];
+        for (std::size_t s = chunks[c].begin; s < chunks[c].end; ++s)
+            for (std::uint32_t p = groom.strandStart[s]; p + 1 < groom.strandStart[s + 1]; ++p) {
+                const Vec3d a = Vec3d(groom.points[p]) * invLeaf;
+                const Vec3d d = Vec3d(groom.points[p + 1]) * invLeaf - a;
+                const double longest = std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)});
+                const int steps = std::max(1, static_cast<int>(std::ceil(longest)));
+                for (int k = 0; k <= steps; ++k) {
+                    const Vec3i leaf = floorToInt(a + (double(k) / steps) * d);
+                    keys.push_back(hash({leaf.x, leaf.y, leaf.z}));
+                }
+            }
+        std::sort(keys.begin(), keys.end());
+        keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+    });
+    std::vector<std::uint64_t> all;
+    for (auto& keys : perChunk) {
+        all.insert(all.end(), keys.begin(), keys.end());
+        std::vector<std::uint64_t>().swap(keys);
+    }
+    std::sort(all.begin(), all.end());
+    return double(std::unique(all.begin(), all.end()) - all.begin()) * kLeafSpill;
 }
 
 void validateOptions(const SplatOptions& o) {
@@ -754,7 +789,8 @@ void validateOptions(const SplatOptions& o) {
 
 /// Refuses, before anything is allocated, a voxel size that the groom's
 /// coordinates, the float density or the memory budget cannot take.
-void checkVoxelSizeForGroom(const Groom& groom, const GroomScan& scan, double h, double defaultH,
+void checkVoxelSizeForGroom(const Groom& groom, const std::vector<StrandRange>& chunks,
+                            const GroomScan& scan, double h, double defaultH,
                             const SplatOptions& options) {
     const Vec3f lo = glm::abs(scan.bounds.min), hi = glm::abs(scan.bounds.max);
     const auto reach = static_cast<double>(std::max({lo.x, lo.y, lo.z, hi.x, hi.y, hi.z}));
@@ -767,15 +803,24 @@ void checkVoxelSizeForGroom(const Groom& groom, const GroomScan& scan, double h,
     if (!(scan.totalLength / (h * h * h) < double(FLT_MAX)))
         throw InputError(strCat("voxelize: voxel size ", h,
                                 " is too small: the length density would overflow a float"));
-    const MemoryEstimate memory =
-        estimateMemory(groom, scan, h, options.storeOrientationTensor, options.threaded);
-    if (memory.bytes > double(options.memoryBudgetBytes)) {
+
+    const auto budget = double(options.memoryBudgetBytes);
+    const auto bytesFor = [&](double leaves) {
+        return memoryForLeaves(leaves, groom, scan, h, options.storeOrientationTensor,
+                               options.threaded);
+    };
+    double leaves = leafBound(groom, scan, h);
+    // Within 16× of the budget the bound may just be loose: count instead.
+    if (bytesFor(leaves) > budget && bytesFor(leaves) <= 16 * budget)
+        leaves = std::min(leaves, sampledLeafCount(groom, chunks, h, options.threaded));
+    const double bytes = bytesFor(leaves);
+    if (bytes > budget) {
         std::ostringstream os;
         os << std::setprecision(3) << "voxelize: voxel size " << h << " would need about "
-           << formatGiB(memory.bytes) << " GiB (estimate: " << memory.leaves
-           << " leaf nodes of 8³ voxels), over the memory budget of "
-           << formatGiB(double(options.memoryBudgetBytes))
-           << " GiB; use a larger voxel size (this groom's default is " << defaultH << ")";
+           << formatGiB(bytes) << " GiB (estimate: " << leaves
+           << " leaf nodes of 8³ voxels per grid), over the memory budget of "
+           << formatGiB(budget) << " GiB; use a larger voxel size (this groom's default is "
+           << defaultH << ")";
         throw InputError(os.str());
     }
 }
@@ -809,7 +854,7 @@ FiberGrid splatStrands(const Groom& groom, const SplatOptions& options) {
     const bool tensor = options.storeOrientationTensor;
     const bool hasLength = scan.totalLength > 0;
     if (hasLength)
-        checkVoxelSizeForGroom(groom, scan, h, defaultH, options);
+        checkVoxelSizeForGroom(groom, chunks, scan, h, defaultH, options);
     // OpenVDB refuses linear transforms whose determinant h³ is below 3e-15.
     const double minVoxelSize = std::cbrt(3 * openvdb::math::Tolerance<double>::value());
     if (h < minVoxelSize)

@@ -107,12 +107,14 @@ struct FiberGrid {
 std::ostream& operator<<(std::ostream& os, const FiberGrid& grid);
 
 /// The default voxel size is the longest side of the groom's bounding box
-/// divided by this. Why a count across the box: it does not depend on units
-/// or strand count, it bounds the work and memory (at most 256³ voxels, of
-/// which a head of hair fills a few percent), and it resolves the hair volume
-/// — a 30 cm groom gets ~1.2 mm voxels, i.e. ~10–20 voxels through a 1–3 cm
-/// layer of hair, the depth over which the forward-scattered light decays.
-/// The transmittance stage tunes this number against exact ray casting.
+/// divided by this. Why a count across the box: it does not depend on the
+/// units or the strand count, and it bounds work and memory (at most 256³
+/// voxels; the 50,000-strand procedural head, 0.61 m tall, gets 2.4 mm
+/// voxels, 1.05M of them active, 41 MiB) while resolving the hair volume:
+/// ~10 voxels through a 2–3 cm layer of hair, the depth over which the
+/// forward-scattered light decays. At the densest voxels of that head
+/// λ·D ≈ 900 /m, i.e. about 2 fibers crossed per voxel. The transmittance
+/// stage tunes this number against exact ray casting.
 inline constexpr int kDefaultVoxelsAcross = 256;
 
 /// Longest side of groom.bounds() / voxelsAcross. A groom without extent
