@@ -183,6 +183,7 @@ struct BenchJob {
     BenchConfig config;
     double voxelSize = 0; ///< grid voxel size or exact footprint radius; 0: h0
     int runs = 1;
+    double singleRunAbove = 0; ///< seconds; a first run longer than this is the only one
     int threads = 0;
     bool isolated = false; ///< in its own process: its peak memory is its own
     std::filesystem::path scratch; ///< where the renders write their outputs
@@ -232,6 +233,7 @@ json jobToJson(const BenchJob& job) {
             {"shading_rate", toString(job.config.shadingRate)},
             {"voxel_size", job.voxelSize},
             {"runs", job.runs},
+            {"single_run_above", job.singleRunAbove},
             {"threads", job.threads},
             {"isolated", job.isolated},
             {"scratch", job.scratch.string()},
@@ -254,6 +256,7 @@ BenchJob jobFromJson(const json& j) {
     job.config.shadingRate = parseShadingRate(j.at("shading_rate").get<std::string>()).value();
     job.voxelSize = j.at("voxel_size").get<double>();
     job.runs = j.at("runs").get<int>();
+    job.singleRunAbove = j.at("single_run_above").get<double>();
     job.threads = j.at("threads").get<int>();
     job.isolated = j.at("isolated").get<bool>();
     job.scratch = j.at("scratch").get<std::string>();
@@ -403,12 +406,14 @@ ProbeError meanProbeError(const std::vector<std::vector<GlobalTerm>>& estimate,
     return mean;
 }
 
-/// Renders the job's configuration `runs` times end to end and takes medians.
+/// Renders the job's configuration `runs` times end to end (once if the first
+/// run is longer than singleRunAbove) and takes medians.
 BenchMeasurement timeRenders(const Scene& scene, const BenchJob& job,
                              const PipelineOptions& options, Film* lastFilm) {
     std::vector<double> load, voxelize, tables, globalTerm, raster, shade, write, total;
     BenchMeasurement m;
-    for (int r = 0; r < job.runs; ++r) {
+    int runs = job.runs;
+    for (int r = 0; r < runs; ++r) {
         SceneRender render = renderScene(scene, options, true);
         const StageTimes& t = render.times;
         load.push_back(t.load);
@@ -424,13 +429,16 @@ BenchMeasurement timeRenders(const Scene& scene, const BenchJob& job,
         m.activeVoxels = render.activeVoxels;
         m.voxelSize = scene.globalTermMode == GlobalTermMode::Exact ? double(scene.exact.radius)
                                                                     : render.voxelSize;
-        if (r + 1 == job.runs && lastFilm)
+        if (r == 0 && job.singleRunAbove > 0 && t.total() > job.singleRunAbove)
+            runs = 1;
+        // Only the last film is kept: holding one across renders would raise the peak.
+        if (r + 1 == runs && lastFilm)
             *lastFilm = std::move(render.image.film);
     }
     m.times = {median(load),   median(voxelize), median(tables), median(globalTerm),
                median(raster), median(shade),    median(write)};
     m.totalSeconds = median(total);
-    m.runs = job.runs;
+    m.runs = runs;
     if (job.isolated)
         m.peakMiB = peakResidentMiB();
     return m;
@@ -553,8 +561,6 @@ struct RunInfo {
 std::string csvNumber(double v) { return format("%.6g", v); }
 std::string csvOptional(const std::optional<double>& v) { return v ? csvNumber(*v) : ""; }
 
-std::string rateText(ShadingRate rate) { return toString(rate); }
-
 std::string csvText(const std::vector<BenchRow>& rows) {
     std::string out;
     for (std::size_t i = 0; i < kBenchCsvColumns.size(); ++i)
@@ -570,7 +576,7 @@ std::string csvText(const std::vector<BenchRow>& rows) {
             csvNumber(r.config.voxelScale),
             csvNumber(m.voxelSize),
             r.config.mode == GlobalTermMode::Exact ? std::to_string(r.config.rays) : "",
-            rateText(r.config.shadingRate),
+            toString(r.config.shadingRate),
             std::to_string(r.width),
             std::to_string(r.height),
             std::to_string(m.segments),
@@ -678,7 +684,12 @@ std::string markdownText(const SweepOptions& o, const SweepResult& result, const
     md += strCat("Times are seconds, end to end through `renderScene()` including writing the EXR "
                  "and PNG; each stage is the median of ",
                  o.runs, o.runs == 1 ? " run" : " runs",
-                 " and `total` the median of the totals (the exact reference: one run). "
+                 " and `total` the median of the totals (the exact reference: one run",
+                 o.singleRunAbove > 0 && o.runs > 1
+                     ? strCat("; a configuration whose first run takes over ",
+                              format("%g", o.singleRunAbove), " s: one run")
+                     : std::string(),
+                 "). "
                  "Peak MiB is the resident peak of a process that ran that configuration alone. "
                  "Errors are against an exact-mode render with K rays per shading point spread "
                  "over a disk of one default voxel h0 (the scene's grid voxel size): relative L1 "
@@ -686,7 +697,11 @@ std::string markdownText(const SweepOptions& o, const SweepResult& result, const
                  o.probePoints, " points on the fibers toward each light, against exact mode with ",
                  o.probeRays,
                  " rays over a disk of the configuration's voxel size. `grid xS`/`approx xS`: "
-                 "voxel size S·h0; `exact K=n`: n rays over the h0 disk.\n\n");
+                 "voxel size S·h0; `exact K=n`: n rays over the h0 disk. The image reference "
+                 "is itself noisy (a few rays per shading point): its estimated share of the "
+                 "rel L1, from the error of the exact configuration with the fewest rays "
+                 "assuming variance ∝ 1/K, is the summary's last column — image errors near "
+                 "it are at the reference's noise floor.\n\n");
 
     const std::vector<std::string> scenes = sceneOrder(rows, BenchSweepKind::Reference);
     if (!scenes.empty()) {
@@ -696,8 +711,9 @@ std::string markdownText(const SweepOptions& o, const SweepResult& result, const
         md += strCat("## Summary (", toString(rate), " shading)\n\n");
         md += strCat("| scene | segments | image | h0 | exact reference s | exact K=", fewestRays,
                      " s | grid x1 s | grid speed-up: global term, total | grid x1 rel L1 | "
-                     "MAE(V) | MAE(T_s) | approx within grid's time | its rel L1 |\n");
-        md += "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|\n";
+                     "MAE(V) | MAE(T_s) | approx within grid's time | its rel L1 | reference "
+                     "noise (est.) |\n");
+        md += "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|\n";
         for (const std::string& s : scenes) {
             const BenchRow* ref = findRow(rows, s, [](const BenchRow& r) {
                 return r.kind == BenchSweepKind::Reference;
@@ -756,7 +772,15 @@ std::string markdownText(const SweepOptions& o, const SweepResult& result, const
             line += approx ? strCat(approx->config.label(), " (", seconds(approx->m.totalSeconds),
                                     " s", withinBudget ? "" : ", none was as fast", ")")
                            : std::string("–");
-            line += strCat(" | ", mdOptional(relL1(approx), 4), " |\n");
+            // The reference's own noise, from the error of exact K=a against it:
+            // with independent rays, variance ∝ 1/K, so err² ≈ σ²(1/a + 1/K_ref)
+            // and the reference's share is err·sqrt(a / (a + K_ref)).
+            const std::optional<double> noise =
+                relL1(exact) ? std::optional(*relL1(exact) *
+                                             std::sqrt(double(fewestRays) /
+                                                       double(fewestRays + o.referenceRays)))
+                             : std::nullopt;
+            line += strCat(" | ", mdOptional(relL1(approx), 4), " | ", mdOptional(noise, 4), " |\n");
             md += line;
         }
         md += "\n";
@@ -779,7 +803,7 @@ std::string markdownText(const SweepOptions& o, const SweepResult& result, const
                 continue;
             const BenchMeasurement& m = r.m;
             md += strCat("| ", configText(r), " | ", format("%.3g", m.voxelSize), " | ",
-                         rateText(r.config.shadingRate), " |", stageCells(m), " ",
+                         toString(r.config.shadingRate), " |", stageCells(m), " ",
                          mdOptional(m.image ? std::optional(m.image->relL1) : std::nullopt, 4),
                          " | ",
                          mdOptional(m.image ? std::optional(m.image->relRmse) : std::nullopt, 4),
@@ -1106,21 +1130,23 @@ LogAxis fitAxis(const std::vector<double>& values, float p0, float p1) {
 
 std::string tickText(double v) {
     if (v >= 1e5 || v < 1e-3) {
-        const int e = int(std::lround(std::log10(v)));
+        const int e = int(std::floor(std::log10(v) + 1e-9));
         const double mantissa = v / std::pow(10.0, e);
         return std::abs(mantissa - 1.0) < 1e-9 ? strCat("1e", e) : strCat(format("%g", mantissa), "e", e);
     }
     return format("%g", v);
 }
 
-/// Tick values of a log axis: 1, 2, 5 per decade (1 only when it spans many).
+/// Tick values of a log axis: every integer mantissa within a decade, 1, 2, 5
+/// per decade over a few, powers of ten beyond.
 std::vector<double> ticks(const LogAxis& a) {
+    const double span = a.hi - a.lo;
+    const std::vector<double> mantissas = span <= 1.2   ? std::vector<double>{1, 2, 3, 4, 5, 6, 7, 8, 9}
+                                          : span <= 3.0 ? std::vector<double>{1, 2, 5}
+                                                        : std::vector<double>{1};
     std::vector<double> out;
-    const bool dense = a.hi - a.lo <= 3.0;
     for (int d = int(std::floor(a.lo)); d <= int(std::ceil(a.hi)); ++d)
-        for (const double m : {1.0, 2.0, 5.0}) {
-            if (!dense && m != 1.0)
-                continue;
+        for (const double m : mantissas) {
             const double v = m * std::pow(10.0, d);
             if (std::log10(v) >= a.lo && std::log10(v) <= a.hi)
                 out.push_back(v);
@@ -1130,7 +1156,7 @@ std::vector<double> ticks(const LogAxis& a) {
 
 /// One log-log panel in the box (x0, y0)–(x1, y1) of the canvas, legend on its right.
 void drawPlot(Canvas& c, float x0, float y0, float x1, float y1, const PlotSpec& spec) {
-    const float legendWidth = 230;
+    const float legendWidth = 300;
     const float left = x0 + 78, right = x1 - legendWidth, top = y0 + 58, bottom = y1 - 62;
     std::vector<double> xs, ys;
     for (const PlotSeries& s : spec.series) {
@@ -1254,8 +1280,8 @@ bool plotRuntimeVsError(const std::filesystem::path& path, const std::vector<Ben
                   "filled: fragment shading",
                   "hollow: vertex shading",
                   "h0: default voxel size"};
-    Canvas canvas(1280, 820);
-    drawPlot(canvas, 0, 0, 1280, 820, spec);
+    Canvas canvas(1400, 820);
+    drawPlot(canvas, 0, 0, 1400, 820, spec);
     writeCanvasPng(path, canvas);
     return true;
 }
@@ -1264,7 +1290,7 @@ bool plotScaling(const std::filesystem::path& path, const std::vector<BenchRow>&
                  const std::vector<ScalingFit>& fits) {
     if (fits.empty())
         return false;
-    const float panelWidth = 760;
+    const float panelWidth = 820;
     Canvas canvas(int(panelWidth) * int(fits.size()), 620);
     float x0 = 0;
     for (const ScalingFit& fit : fits) {
@@ -1531,10 +1557,12 @@ SweepOptions SweepOptions::quick() {
     curly.label = "curly 512^2";
     curly.style = GroomStyle::Curly;
     o.scenes = {wavy, curly};
-    o.voxelScales = {2, 1, 0.7};
+    o.voxelScales = {4, 2, 1};
     o.exactRays = {1};
     o.referenceRays = 4;
+    o.shadingRates = {ShadingRate::Fragment};
     o.probePoints = 500;
+    o.runs = 1;
     for (const std::uint32_t strands : {357u, 3571u, 14286u}) {
         BenchScene s;
         s.label = strCat("wavy ", strands, " strands");
@@ -1578,6 +1606,8 @@ void SweepOptions::validate() const {
         throw InputError("bench: reference and probe rays must be in [1, 65536]");
     if (runs < 1 || runs > 100)
         throw InputError(strCat("bench: runs ", runs, " outside [1, 100]"));
+    if (!(singleRunAbove >= 0))
+        throw InputError(strCat("bench: singleRunAbove ", singleRunAbove, " should be ≥ 0"));
     if (outDir.empty())
         throw InputError("bench: empty output directory");
 }
@@ -1621,6 +1651,7 @@ SweepResult runSweep(const SweepOptions& o) {
         const double load = loadAverage();
         info.loadMax = std::max(info.loadMax, load);
         job.runs = kind == BenchSweepKind::Reference ? 1 : o.runs;
+        job.singleRunAbove = o.singleRunAbove;
         job.threads = o.threads;
         job.isolated = !o.workerCommand.empty();
         job.scratch = work.path() / "scratch";

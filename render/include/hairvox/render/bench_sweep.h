@@ -4,8 +4,9 @@
 // Accuracy sweep. For each scene: global-term mode (exact, grid, approx) ×
 // voxel size × shading rate. Each configuration is rendered end to end with
 // renderScene() (outputs written to a scratch directory, so the `write` stage
-// is real) `runs` times; every stage time is the median over the runs and the
-// total is the median of the totals. It is compared with the scene's
+// is real) `runs` times (once if the first run exceeds `singleRunAbove`);
+// every stage time is the median over the runs and the total is the median of
+// the totals. It is compared with the scene's
 // reference, an exact-mode render of the same scene and camera:
 //  - image: relative L1 = Σ|I − I_ref| / Σ|I_ref| and relative RMSE =
 //    sqrt(mean (I − I_ref)²) / mean I_ref of the beauty RGB over hair pixels
@@ -172,6 +173,9 @@ struct SweepOptions {
     std::vector<BenchScene> segmentScaling; ///< scenes of increasing segment count
     std::vector<BenchScene> pixelScaling;   ///< scenes of increasing image size
     int runs = 3;                        ///< timed renders per configuration, [1, 100]
+    /// A configuration whose first run takes longer (seconds) is run once: the
+    /// exact configurations cost minutes and vary little. 0: always `runs`.
+    double singleRunAbove = 60;
     int threads = 0;                     ///< 0: all cores
     std::filesystem::path outDir = "bench";
     /// Runs each job as `workerCommand... JOB.json` in a child process (the
@@ -187,8 +191,9 @@ struct SweepOptions {
     /// and 256²–2048².
     static SweepOptions full(const std::filesystem::path& ratboyScene);
     /// A representative subset in under 15 minutes on 2 cores: wavy and curly
-    /// at 512², three voxel sizes, exact with 1 ray against 4, both shading
-    /// rates; scaling 10k–400k segments at 960×540 and 256²–1024².
+    /// at 512², voxel sizes ×4, ×2, ×1, exact with 1 ray against 4, fragment
+    /// shading, one run per configuration; scaling 10k–400k segments at
+    /// 960×540 and 256²–1024².
     static SweepOptions quick();
 
     void validate() const;
