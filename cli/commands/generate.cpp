@@ -1,6 +1,6 @@
 // hairvox generate straight|wavy|curly -o FILE.hair [--strands N] [--points-per-strand M] [--seed S]
 #include "../commands.h"
-#include "../report.h"
+#include <hairvox/core/format.h>
 
 #include <hairvox/core/error.h>
 #include <hairvox/strands/groom_io.h>

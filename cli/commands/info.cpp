@@ -1,6 +1,6 @@
 // hairvox info FILE [--json]: what a groom file holds.
 #include "../commands.h"
-#include "../report.h"
+#include <hairvox/core/format.h>
 
 #include <hairvox/core/error.h>
 #include <hairvox/strands/groom_io.h>

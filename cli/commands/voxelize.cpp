@@ -1,7 +1,7 @@
 // hairvox voxelize HAIRFILE -o grid.vdb [--voxel-size V | --voxels-across N] [--diameter D]
 //                  [--density-scale K] [--orientation-tensor] [--threads N] [--memory-budget GIB]
 #include "../commands.h"
-#include "../report.h"
+#include <hairvox/core/format.h>
 
 #include <hairvox/core/error.h>
 #include <hairvox/core/parallel.h>

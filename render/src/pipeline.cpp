@@ -1,5 +1,6 @@
 #include "dual_scattering_fragment_shader.h"
 
+#include <hairvox/core/format.h>
 #include <hairvox/core/interrupt.h>
 #include <hairvox/core/parallel.h>
 #include <hairvox/render/output.h>
@@ -19,16 +20,6 @@ using Clock = std::chrono::steady_clock;
 
 double secondsSince(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-std::string withThousands(std::uint64_t n) {
-    std::string digits = std::to_string(n), out;
-    for (std::size_t i = 0; i < digits.size(); ++i) {
-        if (i > 0 && (digits.size() - i) % 3 == 0)
-            out += ',';
-        out += digits[i];
-    }
-    return out;
 }
 
 } // namespace
@@ -187,9 +178,9 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
         std::snprintf(line, sizeof(line), "  %-12s %7.3f s  %s\n", stage, seconds, detail.c_str());
         os << line;
     };
-    row("load", r.times.load, withThousands(st.segments) + " segments");
+    row("load", r.times.load, thousands(st.segments) + " segments");
     if (r.voxelSize > 0) {
-        std::snprintf(line, sizeof(line), "%s active voxels of %.3g", withThousands(r.activeVoxels).c_str(),
+        std::snprintf(line, sizeof(line), "%s active voxels of %.3g", thousands(r.activeVoxels).c_str(),
                       r.voxelSize);
         row("voxelize", r.times.voxelize, line);
     } else {
@@ -204,16 +195,16 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
         skippedLights += l.skipped ? 1 : 0;
     }
     row("global term", r.times.globalTerm,
-        withThousands(queries) + " queries; skipped: " + withThousands(skippedLights) +
-            " light(s), " + withThousands(blocked) + " behind the head, " + withThousands(empty) +
+        thousands(queries) + " queries; skipped: " + thousands(skippedLights) +
+            " light(s), " + thousands(blocked) + " behind the head, " + thousands(empty) +
             " with nothing in front");
     row("raster", r.times.raster,
-        withThousands(st.fragments) + " fragments; skipped: " + withThousands(st.segmentsOutsideView) +
-            " segments outside the view, " + withThousands(st.segmentsBehindHead) +
-            " behind the head, " + withThousands(st.segmentTilesSkipped) + " segment-tiles opaque");
+        thousands(st.fragments) + " fragments; skipped: " + thousands(st.segmentsOutsideView) +
+            " segments outside the view, " + thousands(st.segmentsBehindHead) +
+            " behind the head, " + thousands(st.segmentTilesSkipped) + " segment-tiles opaque");
     row("shade", r.times.shade,
-        withThousands(st.shadingPoints) + " shading points; skipped " +
-            withThousands(st.fragmentsBehindOpaque) + " fragments behind opaque pixels");
+        thousands(st.shadingPoints) + " shading points; skipped " +
+            thousands(st.fragmentsBehindOpaque) + " fragments behind opaque pixels");
     std::string written;
     for (const auto& p : r.written)
         written += (written.empty() ? "" : ", ") + p.string();

@@ -40,6 +40,32 @@ inline void addSimpson(Lanes& a, const Lanes& f0, const Lanes& fm, const Lanes& 
         a.v[lane] += w * (f0.v[lane] + 4.0f * fm.v[lane] + f1.v[lane]);
 }
 
+/// Amanatides–Woo traversal of a grid of cubic cells `size` index units wide
+/// along O + s·dir: the current cell, and the s at which the ray leaves it
+/// through each axis' face.
+struct Dda {
+    glm::ivec3 cell, step;
+    Vec3f sNext, sDelta;
+
+    Dda(const Vec3f& O, const Vec3f& dir, const glm::ivec3& startCell, float size) : cell(startCell) {
+        for (int a = 0; a < 3; ++a) {
+            step[a] = dir[a] > 0 ? 1 : (dir[a] < 0 ? -1 : 0);
+            sDelta[a] = dir[a] != 0 ? size / std::abs(dir[a]) : kInfinity;
+            sNext[a] = dir[a] != 0
+                           ? (size * float(cell[a] + (dir[a] > 0 ? 1 : 0)) - O[a]) / dir[a]
+                           : kInfinity;
+        }
+    }
+    float exit() const { return std::min({sNext.x, sNext.y, sNext.z}); }
+    /// Steps into the next cell; returns the axis crossed.
+    int advance() {
+        const int a = sNext.x <= sNext.y ? (sNext.x <= sNext.z ? 0 : 2) : (sNext.y <= sNext.z ? 1 : 2);
+        cell[a] += step[a];
+        sNext[a] += sDelta[a];
+        return a;
+    }
+};
+
 } // namespace
 
 BrickVolume::BrickVolume(double voxelSize)
@@ -138,29 +164,19 @@ void BrickVolume::walkBricks(const Vec3f& O, const Vec3f& dir, float s0, float s
         return;
     // Brick-level DDA (bricks are 8 index units wide).
     const Vec3f p0 = O + s0 * dir;
-    glm::ivec3 b = glm::clamp(glm::ivec3(glm::floor(p0 / float(kBrick))), brickMin_, brickMax_);
-    glm::ivec3 step;
-    Vec3f sNext, sDelta;
-    for (int a = 0; a < 3; ++a) {
-        step[a] = dir[a] > 0 ? 1 : (dir[a] < 0 ? -1 : 0);
-        sDelta[a] = dir[a] != 0 ? float(kBrick) / std::abs(dir[a]) : kInfinity;
-        sNext[a] = dir[a] != 0
-                       ? (float(kBrick * (b[a] + (dir[a] > 0 ? 1 : 0))) - O[a]) / dir[a]
-                       : kInfinity;
-    }
+    Dda dda(O, dir, glm::clamp(glm::ivec3(glm::floor(p0 / float(kBrick))), brickMin_, brickMax_),
+            float(kBrick));
     float s = s0;
     for (;;) {
-        const float sExit = std::min({sNext.x, sNext.y, sNext.z, s1});
-        if (const std::int64_t brick = find(b); brick >= 0 && sExit > s)
-            if (!visit(static_cast<std::size_t>(brick), b, s, sExit))
+        const float sExit = std::min(dda.exit(), s1);
+        if (const std::int64_t brick = find(dda.cell); brick >= 0 && sExit > s)
+            if (!visit(static_cast<std::size_t>(brick), dda.cell, s, sExit))
                 return;
         if (sExit >= s1)
             return;
         s = sExit;
-        const int a = sNext.x <= sNext.y ? (sNext.x <= sNext.z ? 0 : 2) : (sNext.y <= sNext.z ? 1 : 2);
-        b[a] += step[a];
-        sNext[a] += sDelta[a];
-        if (b[a] < brickMin_[a] || b[a] > brickMax_[a])
+        const int a = dda.advance();
+        if (dda.cell[a] < brickMin_[a] || dda.cell[a] > brickMax_[a])
             return;
     }
 }
@@ -173,26 +189,22 @@ void BrickVolume::forEachPiece(std::size_t brick, const glm::ivec3& b, const Vec
     const glm::ivec3 base = kBrick * b;
     // The cell containing the start: on a cell face, the one the ray enters.
     const Vec3f pa = O + sa * dir;
-    glm::ivec3 c;
-    glm::ivec3 step;
-    Vec3f sNext, sDelta;
+    glm::ivec3 start;
     for (int a = 0; a < 3; ++a) {
         int ci = static_cast<int>(std::floor(pa[a]));
         if (dir[a] < 0 && static_cast<float>(ci) == pa[a])
             --ci;
-        c[a] = std::clamp(ci, base[a], base[a] + kBrick - 1);
-        step[a] = dir[a] > 0 ? 1 : (dir[a] < 0 ? -1 : 0);
-        sDelta[a] = dir[a] != 0 ? 1.0f / std::abs(dir[a]) : kInfinity;
-        sNext[a] = dir[a] != 0 ? (float(c[a] + (dir[a] > 0 ? 1 : 0)) - O[a]) / dir[a] : kInfinity;
+        start[a] = std::clamp(ci, base[a], base[a] + kBrick - 1);
     }
+    Dda dda(O, dir, start, 1.0f);
     // The field is continuous: a piece's end value is the next piece's start value.
     float s = sa;
     Lanes fStart;
     bool haveStart = false;
     for (;;) {
-        const float sEnd = std::min({sNext.x, sNext.y, sNext.z, sb});
+        const float sEnd = std::min(dda.exit(), sb);
         if (sEnd > s) {
-            const glm::ivec3 l = c - base;
+            const glm::ivec3 l = dda.cell - base;
             const Lanes* corner[8];
             bool any = false;
             for (int k = 0; k < 8; ++k) {
@@ -200,7 +212,7 @@ void BrickVolume::forEachPiece(std::size_t brick, const glm::ivec3& b, const Vec
                 any = any || corner[k]->v[0] != 0.0f;
             }
             if (any) {
-                const Vec3f cf(c);
+                const Vec3f cf(dda.cell);
                 const auto at = [&](float t) { return trilinear(corner, O + t * dir - cf); };
                 if (!haveStart)
                     fStart = at(s);
@@ -219,10 +231,8 @@ void BrickVolume::forEachPiece(std::size_t brick, const glm::ivec3& b, const Vec
         if (sEnd >= sb)
             break;
         s = sEnd;
-        const int a = sNext.x <= sNext.y ? (sNext.x <= sNext.z ? 0 : 2) : (sNext.y <= sNext.z ? 1 : 2);
-        c[a] += step[a];
-        sNext[a] += sDelta[a];
-        if (c[a] < base[a] || c[a] >= base[a] + kBrick)
+        const int a = dda.advance();
+        if (dda.cell[a] < base[a] || dda.cell[a] >= base[a] + kBrick)
             break;
     }
 }
