@@ -482,19 +482,23 @@ public:
     }
 
     /// Emits the leaves of the brick's own voxels (local [1, 32]) that hold
-    /// fiber, and clears what was touched for the next brick: every corner a
-    /// segment reached is within one voxel of a voxel of a leaf it marked.
+    /// fiber, and clears what was touched for the next brick.
     void extract(const openvdb::Coord& brickOrigin, double invVoxelVolume, BrickLeaves& out) {
         forEachTouchedLeaf([&](const Vec3i& lo) {
             extractLeaf(lo, brickOrigin + openvdb::Coord(lo.x - 1, lo.y - 1, lo.z - 1),
                         invVoxelVolume, out);
         });
-        // Only once all are read: the cleared blocks overlap neighbouring leaves.
+        // Only once all are read: a leaf's block is cleared with the apron
+        // layer below it (and above it at the brick's top), which overlaps
+        // the neighbouring leaf. A corner reached above a leaf belongs to the
+        // next leaf, which the segment's corner box marked too.
         forEachTouchedLeaf([&](const Vec3i& lo) {
-            for (int x = lo.x - 1; x <= lo.x + kLeafDim; ++x)
-                for (int y = lo.y - 1; y <= lo.y + kLeafDim; ++y) {
+            const Vec3i hi =
+                lo + (kLeafDim - 1) + Vec3i(glm::equal(lo + (kLeafDim - 1), Vec3i(kBrickSize)));
+            for (int x = lo.x - 1; x <= hi.x; ++x)
+                for (int y = lo.y - 1; y <= hi.y; ++y) {
                     double* row = &sums_[index(x, y, lo.z - 1)];
-                    std::fill(row, row + std::size_t(kLeafDim + 2) * C, 0.0);
+                    std::fill(row, row + std::size_t(hi.z - lo.z + 2) * C, 0.0);
                 }
         });
         touchedLeaves_ = 0;
@@ -818,9 +822,8 @@ void checkVoxelSizeForGroom(const Groom& groom, const std::vector<StrandRange>& 
         std::ostringstream os;
         os << std::setprecision(3) << "voxelize: voxel size " << h << " would need about "
            << formatGiB(bytes) << " GiB (estimate: " << leaves
-           << " leaf nodes of 8³ voxels per grid), over the memory budget of "
-           << formatGiB(budget) << " GiB; use a larger voxel size (this groom's default is "
-           << defaultH << ")";
+           << " leaf nodes of 8³ voxels per grid), over the memory budget of " << formatGiB(budget)
+           << " GiB; use a larger voxel size (this groom's default is " << defaultH << ")";
         throw InputError(os.str());
     }
 }
@@ -848,7 +851,15 @@ double defaultVoxelSize(const Groom& groom, int voxelsAcross) {
 FiberGrid splatStrands(const Groom& groom, const SplatOptions& options) {
     validateOptions(options);
     const std::vector<StrandRange> chunks = strandChunks(groom);
+    // The content hash is serial: it runs beside the parallel scan.
+    std::uint64_t hash = 0;
+    tbb::task_group hashing;
+    if (options.threaded)
+        hashing.run([&] { hash = contentHash(groom); });
+    else
+        hash = contentHash(groom);
     const GroomScan scan = scanGroom(groom, chunks, options.threaded);
+    hashing.wait();
     const double defaultH = voxelSizeFromBounds(scan.bounds, kDefaultVoxelsAcross);
     const double h = options.voxelSize > 0 ? options.voxelSize : defaultH;
     const bool tensor = options.storeOrientationTensor;
@@ -867,7 +878,7 @@ FiberGrid splatStrands(const Groom& groom, const SplatOptions& options) {
     grid.info.fiberDiameter = options.fiberDiameter;
     grid.info.densityScale = options.densityScale;
     grid.info.sourceFile = options.sourceFile;
-    grid.info.sourceHash = hexDigest(contentHash(groom));
+    grid.info.sourceHash = hexDigest(hash);
     grid.info.strands = groom.strandCount();
     grid.info.segments = groom.segmentCount();
     grid.info.totalLength = scan.totalLength;
