@@ -394,6 +394,15 @@ TEST(Splat, EmptyGroomGivesAnEmptyGridAndAWarning) {
     }
 }
 
+TEST(Splat, SkipsStrandsWithoutSegments) {
+    // Only an unsanitized groom has them; they contribute nothing.
+    Groom groom;
+    groom.strandStart = {0, 0, 1, 3};
+    groom.points = {{5, 5, 5}, {0, 0, 0}, {1, 0, 0}};
+    const FiberGrid g = splatStrands(groom, withVoxelSize(0.25));
+    EXPECT_NEAR(test::splattedLength(g), 1.0, 1e-6);
+}
+
 TEST(Splat, RefusesInvalidOptions) {
     const Groom groom = groomOf({{{0, 0, 0}, {1, 0, 0}}});
     for (double h : {-1.0, std::nan(""), HUGE_VAL})

@@ -67,9 +67,9 @@ constexpr int kLeavesPerBrickSide = kBrickSize / kLeafDim;
 /// Accumulator side: voxels [brick origin − 1, brick origin + 32] hold the
 /// corners of the cells [origin − 1, origin + 31] that touch the brick's voxels.
 constexpr int kAccDim = kBrickSize + 2;
-/// Strands are grouped into chunks of at least this many segments for the
+/// Strands are grouped into chunks of at least this many points for the
 /// scan and the bucketing (fixed by the groom, never by the thread count).
-constexpr std::size_t kChunkSegments = 16384;
+constexpr std::size_t kChunkPoints = 16384;
 /// Coordinates must stay well inside OpenVDB's int32 index space.
 constexpr double kMaxIndex = 1 << 30;
 
@@ -118,14 +118,14 @@ struct StrandRange {
 std::vector<StrandRange> strandChunks(const Groom& groom) {
     std::vector<StrandRange> chunks;
     StrandRange current;
-    std::size_t segments = 0;
+    std::size_t points = 0;
     for (std::size_t s = 0; s < groom.strandCount(); ++s) {
-        segments += groom.strandStart[s + 1] - groom.strandStart[s] - 1;
-        if (segments >= kChunkSegments) {
+        points += groom.strand(s).size();
+        if (points >= kChunkPoints) {
             current.end = s + 1;
             chunks.push_back(current);
             current.begin = s + 1;
-            segments = 0;
+            points = 0;
         }
     }
     if (current.begin < groom.strandCount()) {
@@ -297,6 +297,8 @@ void runsOfChunk(const Groom& groom, const StrandRange& chunk, double invH, Chun
     std::vector<Open> open, stillOpen;
     std::vector<BrickKey> keys;
     for (std::size_t s = chunk.begin; s < chunk.end; ++s) {
+        if (groom.strand(s).size() < 2)
+            continue; // no segment (only an unsanitized groom has such strands)
         const std::uint32_t first = groom.strandStart[s], last = groom.strandStart[s + 1] - 1;
         for (std::uint32_t p = first; p < last; ++p) {
             const Vec3f& p0 = groom.points[p];
