@@ -21,7 +21,7 @@
 //       Σ_v λ_v h³ = total fiber length,  and  ∫ (trilinear λ) dV = total fiber length.
 //   The integrals are exact: each segment is clipped to the cells it crosses
 //   (3D DDA); inside one cell each weight is a cubic polynomial of the line
-//   parameter, which Simpson's rule integrates exactly.
+//   parameter, integrated in closed form (what Simpson's rule gives too).
 //
 // Orientation statistics (per voxel, weighted by the same w_v ds)
 // ----------------------------------------------------------------
