@@ -137,7 +137,13 @@ std::vector<Vec3f> growCentreline(const HeadSphere& head, const Vec3f& rootDir, 
     // Comb direction: "back and down" projected onto the scalp's tangent plane.
     const Vec3f combTarget = -kForward - 0.6f * kUp;
     const Vec3f comb = normalizeOr(combTarget - glm::dot(combTarget, rootDir) * rootDir, -kForward);
-    Vec3f tilt(normalVariate(rng), normalVariate(rng), normalVariate(rng));
+    // One draw per statement: the evaluation order of constructor arguments is
+    // unspecified (GCC and Clang differ), and a groom must not depend on the
+    // compiler. z, y, x is the order GCC used, so existing grooms keep their points.
+    const float tiltZ = normalVariate(rng);
+    const float tiltY = normalVariate(rng);
+    const float tiltX = normalVariate(rng);
+    Vec3f tilt(tiltX, tiltY, tiltZ);
     tilt -= glm::dot(tilt, rootDir) * rootDir;
     Vec3f dir = normalizeOr(comb + (0.15f + 0.15f * rng.uniformFloat()) * rootDir + 0.2f * tilt,
                             rootDir);
