@@ -30,8 +30,11 @@ namespace hairvox::test {
 
 /// True when this binary (and so the hairvox it tests) runs under a sanitizer
 /// that reserves terabytes of address space: RLIMIT_AS cannot bound it.
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__) // GCC
 inline constexpr bool kSanitizedBuild = true;
+#elif defined(__has_feature)                                         // Clang
+inline constexpr bool kSanitizedBuild =
+    __has_feature(address_sanitizer) || __has_feature(thread_sanitizer);
 #else
 inline constexpr bool kSanitizedBuild = false;
 #endif

@@ -8,7 +8,9 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cstdio>
+#include <thread>
 
 namespace hairvox {
 namespace {
@@ -103,6 +105,26 @@ TEST_F(InterruptSlow, SigtermStopsLikeCtrlC) {
         return c.secondsRunning() >= 0.5 * seconds_;
     });
     EXPECT_GE(latency, 0) << "the render finished before SIGTERM";
+}
+
+TEST_F(InterruptSlow, SecondCtrlCEndsTheProcessAtOnce) {
+    const fs::path d = dir_ / "twice";
+    test::Child child(test::renderOptions(scene_, d, dir_ / "cache-ref"));
+    test::waitFor(child, [&] { return child.secondsRunning() >= 0.3 * seconds_; }, kRenderTimeLimit);
+    child.signal(SIGINT);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    const auto sent = test::Clock::now();
+    child.signal(SIGINT);
+    const test::ChildResult r = child.wait(kRenderTimeLimit);
+    const double latency = std::chrono::duration<double>(test::Clock::now() - sent).count();
+    if (r.exited) { // the first Ctrl-C was fast enough to end the render on its own
+        EXPECT_EQ(r.exitCode, 130) << r.output;
+    } else {
+        EXPECT_EQ(r.signal, SIGINT) << r.output;
+    }
+    EXPECT_LT(latency, 0.5);
+    EXPECT_FALSE(fs::exists(d / "out.exr"));
+    EXPECT_FALSE(fs::exists(d / "out.png"));
 }
 
 } // namespace
