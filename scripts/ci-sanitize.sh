@@ -3,13 +3,14 @@
 #
 #   scripts/ci-sanitize.sh [all|tests|fuzz]     (default: all)
 #
-# One clang build, build/sanitize, with AddressSanitizer + UndefinedBehavior-
-# Sanitizer (every report is fatal) and the libFuzzer targets of fuzz/:
+# One clang build, build/sanitize (or $HAIRVOX_SANITIZE_DIR), with Address-
+# Sanitizer + UndefinedBehaviorSanitizer (every report is fatal) and the
+# libFuzzer targets of fuzz/:
 #   tests  the fast tests (ctest -L fast) under the sanitizers;
 #   fuzz   each fuzzer (hair, tfx, obj, scene) for HAIRVOX_FUZZ_SECONDS (default
 #          60) from its committed seed corpus fuzz/corpus/<target>/, two at a
 #          time; new corpus entries go to a temporary directory, crashing inputs
-#          to build/sanitize/fuzz-findings/.
+#          to <build>/fuzz-findings/.
 # Sharing one build for both halves keeps CI under 30 minutes on 2 cores. Clang
 # warnings are not errors here (the GCC release build enforces -Werror); the
 # third-party code exempted from a check is in scripts/ci-sanitize-ignorelist.txt.
@@ -19,7 +20,7 @@ cd "$(dirname "$0")/.."
 what=${1:-all}
 case "$what" in all|tests|fuzz) ;; *) echo "ci-sanitize.sh: unknown job '$what' (all, tests, fuzz)" >&2; exit 2 ;; esac
 jobs=${HAIRVOX_JOBS:-2}
-build=build/sanitize
+build=${HAIRVOX_SANITIZE_DIR:-build/sanitize}
 fuzzers=(hair tfx obj scene)
 
 stamp() { printf '%s: %s (%d:%02d elapsed)\n' "ci-sanitize" "$1" $((SECONDS / 60)) $((SECONDS % 60)); }
