@@ -255,7 +255,9 @@ def malformed():
 
     expected.sort()
     (BAD / "expected.txt").write_text(
-        "# file<TAB>fragment of the error message (tests/reliability/malformed_input_test.cpp)\n"
+        "# The malformed-input corpus, made by tests/reliability/make_corpora.py: every file\n"
+        "# must make the CLI exit with code 2 and an error containing its fragment\n"
+        "# (tests/reliability/malformed_input_test.cpp). file<TAB>fragment\n"
         + "".join(f"{name}\t{fragment}\n" for name, fragment in expected))
 
 
