@@ -1,6 +1,6 @@
 // hairvox render: writing the film — OpenEXR with AOV layers, and a PNG preview.
 //
-// EXR (one scanline file, ZIP compression, written atomically):
+// EXR (one scanline file, ZIPS compression, written atomically):
 //   R G B A                       beauty (= the sum of the radiance layers) and alpha
 //   direct_R.{R,G,B}  direct_TT.*  direct_TRT.*   single scattering per lobe
 //   back_direct.*                 f_back^direct: local multiple scattering
