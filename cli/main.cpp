@@ -6,6 +6,7 @@
 
 #include <hairvox/core/error.h>
 #include <hairvox/core/interrupt.h>
+#include <hairvox/core/version.h>
 
 #include <CLI/CLI.hpp>
 
@@ -13,9 +14,9 @@
 #include <exception>
 
 int main(int argc, char** argv) {
-    CLI::App app{"hairvox " HAIRVOX_VERSION
+    CLI::App app{std::string("hairvox ") + hairvox::version() +
                  ": hair rendering with a voxel-grid dual-scattering global term"};
-    app.set_version_flag("--version", std::string(HAIRVOX_VERSION));
+    app.set_version_flag("--version", std::string(hairvox::version()));
     app.require_subcommand(1, 1);
     hairvox::cli::addBenchCommand(app);
     hairvox::cli::addGenerateCommand(app);

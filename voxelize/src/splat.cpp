@@ -19,6 +19,7 @@
 #include <hairvox/core/interrupt.h>
 #include <hairvox/core/parallel.h>
 #include <hairvox/core/progress.h>
+#include <hairvox/core/version.h>
 #include <hairvox/voxelize/fiber_grid.h>
 
 #include <tbb/blocked_range.h>
@@ -40,9 +41,6 @@
 #include <sstream>
 #include <unordered_map>
 
-#ifndef HAIRVOX_VERSION
-#error "HAIRVOX_VERSION must be defined by the build"
-#endif
 
 namespace hairvox {
 
@@ -884,7 +882,7 @@ FiberGrid splatStrands(const Groom& groom, const SplatOptions& options) {
     grid.info.strands = groom.strandCount();
     grid.info.segments = groom.segmentCount();
     grid.info.totalLength = scan.totalLength;
-    grid.info.version = HAIRVOX_VERSION;
+    grid.info.version = version();
     grid.density = makeGrid<openvdb::FloatGrid>(kDensityGridName, h);
     grid.density->setGridClass(openvdb::GRID_FOG_VOLUME);
     grid.orientation = makeGrid<openvdb::Vec3SGrid>(kOrientationGridName, h);

@@ -30,6 +30,7 @@ struct Groom {
 
     std::size_t strandCount() const { return strandStart.empty() ? 0 : strandStart.size() - 1; }
     std::size_t pointCount() const { return points.size(); }
+    /// Valid for sanitized grooms (every strand has ≥ 2 points; see sanitizeGroom()).
     std::size_t segmentCount() const { return points.size() - strandCount(); }
     bool empty() const { return strandCount() == 0; }
 

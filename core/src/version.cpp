@@ -1,0 +1,7 @@
+#include <hairvox/core/version.h>
+
+namespace hairvox {
+
+const char* version() { return HAIRVOX_VERSION; }
+
+} // namespace hairvox
