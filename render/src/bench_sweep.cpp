@@ -1736,6 +1736,7 @@ SweepResult runSweep(const SweepOptions& o) {
                     result.rows.back().m.probe = probe;
             }
         }
+        info.loadEnd = loadAverage(); // so far: the outputs are complete up to this scene
         result.written = writeSweepOutputs(o, result, info);
     }
 
