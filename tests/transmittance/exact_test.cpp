@@ -30,14 +30,19 @@ GlobalTerm evaluateAt(const GlobalTermModel& model, const LightGeometry& light, 
     return out;
 }
 
-TEST(ExactGlobalTerm, SlabMatchesPoissonClosedForms) {
+/// The slab seen by exact mode with density multiplier k: k·λ hairs per unit
+/// volume at independent positions, so n, V, P and σ_f² take the Poisson
+/// closed forms of k·n₁ crossings (issue 5's analytic slab).
+void expectSlabMatchesPoissonClosedForms(float densityMultiplier) {
     const test::Slab slab;
     const Groom groom = slab.groom();
     const float aBar = 0.55f;
     ExactOptions options;
     options.rays = 64;
     options.radius = 0.004f;
-    const auto model = makeExactModel(groom, constantTable(aBar, 0.02f), settings(), options);
+    GlobalTermSettings s = settings();
+    s.densityMultiplier = densityMultiplier;
+    const auto model = makeExactModel(groom, constantTable(aBar, 0.02f), s, options);
 
     for (const Vec3f dir : {Vec3f(0, 1, 0), Vec3f(0.5f, 1, 0), Vec3f(0, 1, 0.6f),
                             Vec3f(-0.4f, 1, 0.4f), Vec3f(0.8f, 1, -0.2f)}) {
@@ -60,7 +65,7 @@ TEST(ExactGlobalTerm, SlabMatchesPoissonClosedForms) {
             P += double(g.P.r) / double(out.size());
             sigma2 += double(g.sigma2_f.r) / double(out.size());
         }
-        const double nExpected = slab.expectedN(omega, kDiameter);
+        const double nExpected = double(densityMultiplier) * slab.expectedN(omega, kDiameter);
         EXPECT_NEAR(n, nExpected, 0.03 * nExpected) << omega;
         EXPECT_NEAR(V, std::exp(-nExpected), 0.02) << omega;
         EXPECT_NEAR(P, std::exp(-nExpected * (1 - double(aBar))), 0.02) << omega;
@@ -68,6 +73,16 @@ TEST(ExactGlobalTerm, SlabMatchesPoissonClosedForms) {
         EXPECT_NEAR(sigma2, 0.02 * nExpected / -std::expm1(-nExpected), 0.04 * 0.02 * nExpected)
             << omega;
     }
+}
+
+TEST(ExactGlobalTerm, SlabMatchesPoissonClosedForms) { expectSlabMatchesPoissonClosedForms(1.0f); }
+
+// A modeled strand standing for k hairs is k hairs side by side (a ribbon k·D
+// wide), not k hairs stacked on one spot: V falls as e^{−k·n₁}, as the grid
+// and the rasterizer assume, instead of staying at e^{−n₁}.
+TEST(ExactGlobalTerm, DensityMultiplierAddsIndependentHairs) {
+    expectSlabMatchesPoissonClosedForms(2.0f);
+    expectSlabMatchesPoissonClosedForms(0.5f);
 }
 
 TEST(ExactGlobalTerm, EmptySpaceIsExactlyUnoccluded) {

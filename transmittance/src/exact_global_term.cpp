@@ -151,10 +151,11 @@ struct StrandRayCaster::Impl {
     }
 };
 
-StrandRayCaster::StrandRayCaster(const Groom& groom, float fiberDiameter)
-    : impl_(std::make_unique<Impl>()), diameter_(fiberDiameter) {
+StrandRayCaster::StrandRayCaster(const Groom& groom, float ribbonWidth, float locateDistance)
+    : impl_(std::make_unique<Impl>()), width_(ribbonWidth),
+      locateDistance_(locateDistance > 0 ? locateDistance : ribbonWidth) {
     Impl& m = *impl_;
-    const float radius = 0.5f * fiberDiameter;
+    const float radius = 0.5f * ribbonWidth;
     m.vertices.reserve(4 * (groom.pointCount() + 1));
     for (const Vec3f& p : groom.points)
         m.vertices.insert(m.vertices.end(), {p.x, p.y, p.z, radius});
@@ -233,12 +234,12 @@ void StrandRayCaster::crossings(const Vec3f& origin, const Vec3f& dir, float tMa
         return a.t != b.t ? a.t < b.t : a.primID < b.primID;
     });
     // A ray through the joint of two consecutive segments of one strand hits
-    // both ribbons within about a diameter: one crossing.
+    // both ribbons within about a ribbon width: one crossing.
     for (const RawHit& h : hits) {
         const std::uint32_t strand = m.segmentStrand[h.primID];
         const bool jointDuplicate = std::any_of(
             out.rbegin(), std::find_if(out.rbegin(), out.rend(),
-                                       [&](const FiberCrossing& c) { return h.t - c.t > 2 * diameter_; }),
+                                       [&](const FiberCrossing& c) { return h.t - c.t > 2 * width_; }),
             [&](const FiberCrossing& c) {
                 return c.strand == strand &&
                        (c.segment + 1 == h.primID || h.primID + 1 == c.segment);
@@ -252,7 +253,7 @@ void StrandRayCaster::crossings(const Vec3f& origin, const Vec3f& dir, float tMa
 std::optional<FiberPoint> StrandRayCaster::locate(const Vec3f& p, std::uint32_t strandHint) const {
     const Impl& m = *impl_;
     std::optional<FiberPoint> best;
-    float bestDistance = diameter_;
+    float bestDistance = locateDistance_;
     const auto consider = [&](std::uint32_t s) {
         const auto [a, b] = m.segmentEnds(s);
         const float d = distanceToSegment(p, a, b);
@@ -277,8 +278,8 @@ std::optional<FiberPoint> StrandRayCaster::locate(const Vec3f& p, std::uint32_t 
             length += double(glm::distance(a, b));
         }
         const float cell = std::max(static_cast<float>(length / double(m.segmentStart.size())),
-                                    4.0f * diameter_);
-        m.grid = std::make_unique<SegmentGrid>(m.segmentStart.size(), cell, diameter_,
+                                    4.0f * locateDistance_);
+        m.grid = std::make_unique<SegmentGrid>(m.segmentStart.size(), cell, locateDistance_,
                                                [&](std::size_t s) { return m.segmentEnds(s); });
     });
     m.grid->forEachNear(p, consider);
@@ -307,7 +308,9 @@ class ExactModel final : public GlobalTermModel {
 public:
     ExactModel(const Groom& groom, const CrossingTable& crossingTable,
                const GlobalTermSettings& globalSettings, const ExactOptions& exactOptions)
-        : caster(groom, globalSettings.fiberDiameter), crossings(crossingTable),
+        : caster(groom, globalSettings.densityMultiplier * globalSettings.fiberDiameter,
+                 std::max(1.0f, globalSettings.densityMultiplier) * globalSettings.fiberDiameter),
+          crossings(crossingTable),
           settings(globalSettings), options(exactOptions) {}
 
     GlobalTermMode mode() const override { return GlobalTermMode::Exact; }
@@ -334,10 +337,8 @@ GlobalTerm ExactLightGlobalTerm::evaluateOne(const GlobalTermQuery& q,
     if (!(path.distance > 0))
         return GlobalTerm::unoccluded();
     const ExactOptions& opt = model_.options;
-    const float k = model_.settings.densityMultiplier;
-    const float D = model_.caster.fiberDiameter();
     const std::optional<FiberPoint> own = model_.caster.locate(q.position, q.strand);
-    const float ownSlack = 2.0f * (opt.radius + D);
+    const float ownSlack = 2.0f * (opt.radius + model_.caster.ribbonWidth());
 
     Vec3f e1, e2;
     coordinateSystem(path.omega, e1, e2);
@@ -369,11 +370,11 @@ GlobalTerm ExactLightGlobalTerm::evaluateOne(const GlobalTermQuery& q,
             beta2 += v.beta2Bar_f;
             ++m;
         }
-        nSum += static_cast<double>(k) * m;
+        nSum += m;
         vSum += m == 0 ? 1.0 : 0.0;
-        pSum += Rgbd(exp(k * logP));
+        pSum += Rgbd(exp(logP));
         if (m > 0) {
-            beta2Sum += Rgbd(k * beta2);
+            beta2Sum += Rgbd(beta2);
             crossedRays += 1;
         }
     }

@@ -1,13 +1,18 @@
 // hairvox transmittance: the exact global term by ray casting (docs/DESIGN.md §5).
 //
-// The strands become Embree 3 flat linear curves of the fiber diameter D:
-// ray-facing ribbons, so a ray crossing a fiber of tangent u registers one hit
-// with probability proportional to D·|ω × u| — the cross-section the grid
-// modes integrate. All hits along a shadow ray are collected (a context filter
-// rejects every hit, so traversal continues), sorted, and deduplicated: Embree
-// can report the same primitive twice, and a ray through the joint of two
-// segments of one strand hits both ribbons. For one ray crossing fibers
-// k = 1..m (each standing for `densityMultiplier` real hairs):
+// The strands become Embree 3 flat linear curves: ray-facing ribbons, so a ray
+// crossing a fiber of tangent u registers one hit with probability
+// proportional to the ribbon width times |ω × u| — the cross-section the grid
+// modes integrate. The ribbon width is k·D, the fiber diameter D times the
+// density multiplier k: a modeled strand stands for k real hairs lying side by
+// side, so a ray crosses k times as many hairs on average and each crossing
+// is one hair. This is the medium the grid (λ scaled by k) and the rasterizer
+// (coverage 1 − (1 − α)^k) see; counting each hit of a D-wide ribbon k times
+// instead would stack the k hairs on one spot and leave V unchanged by k.
+// All hits along a shadow ray are collected (a context filter rejects every
+// hit, so traversal continues), sorted, and deduplicated: Embree can report
+// the same primitive twice, and a ray through the joint of two segments of one
+// strand hits both ribbons. For one ray crossing fibers k = 1..m:
 //   V = [m = 0],  P = ∏ ā_f(θ_k),  σ_f² = Σ β̄_f²(θ_k),  T_s = d_f (P − V).
 // With K rays whose origins are spread over a disk of radius r perpendicular
 // to the light, the global term is the mean over rays (σ_f² over the rays that
@@ -15,11 +20,11 @@
 //
 // Self-shadowing: the query point lies on its own fiber, which must not count.
 // The own strand is the query's strand hint or else the strand whose
-// centreline passes within D of the point. A hit on that strand is the own
-// fiber when the strand runs nearly straight between the point and the hit —
-// arc length ≤ 1.5 × chord + 2(r + D) — and is dropped; a curl looping back
-// across the ray (arc length much longer than the chord) is another crossing
-// and counts.
+// centreline passes within max(D, k·D) of the point. A hit on that strand is
+// the own fiber when the strand runs nearly straight between the point and
+// the hit — arc length ≤ 1.5 × chord + 2(r + k·D) — and is dropped; a curl
+// looping back across the ray (arc length much longer than the chord) is
+// another crossing and counts.
 #pragma once
 
 #include <hairvox/strands/groom.h>
@@ -59,7 +64,9 @@ struct FiberPoint {
 /// Embree scene of a groom's strands: every fiber crossing along a ray.
 class StrandRayCaster {
 public:
-    StrandRayCaster(const Groom& groom, float fiberDiameter);
+    /// Ribbons of width `ribbonWidth`; locate() searches within `locateDistance`
+    /// (default: the ribbon width) of a centreline.
+    StrandRayCaster(const Groom& groom, float ribbonWidth, float locateDistance = 0);
     ~StrandRayCaster();
     StrandRayCaster(const StrandRayCaster&) = delete;
     StrandRayCaster& operator=(const StrandRayCaster&) = delete;
@@ -69,18 +76,19 @@ public:
     void crossings(const Vec3f& origin, const Vec3f& dir, float tMax,
                    std::vector<FiberCrossing>& out) const;
 
-    /// The point of a strand centreline nearest to p, if one passes within a
-    /// fiber diameter. With a strand hint only that strand is searched;
+    /// The point of a strand centreline nearest to p, if one passes within
+    /// the locate distance. With a strand hint only that strand is searched;
     /// otherwise a uniform grid of segments (built on first use).
     std::optional<FiberPoint> locate(const Vec3f& p,
                                      std::uint32_t strandHint = kUnknownStrand) const;
 
-    float fiberDiameter() const { return diameter_; }
+    float ribbonWidth() const { return width_; }
 
 private:
     struct Impl;
     std::unique_ptr<Impl> impl_;
-    float diameter_;
+    float width_;
+    float locateDistance_;
 };
 
 /// The `exact` mode. Keeps a reference to nothing: the groom is copied into
