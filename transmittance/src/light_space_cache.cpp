@@ -30,7 +30,6 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates,
     cache.h_ = static_cast<float>(rates.voxelSize());
     const Bounds3f bounds = rates.bounds();
     if (bounds.empty()) {
-        cache.lineStart_.assign(1, 0);
         return cache;
     }
     const auto boxCorners = corners(bounds);
@@ -90,8 +89,8 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates,
         static_cast<std::size_t>(std::ceil((sMaxWorld - cache.sBase_) / cache.h_)) + 2;
 
     const auto lines = static_cast<std::size_t>(cache.ni_) * static_cast<std::size_t>(cache.nj_);
-    std::vector<std::vector<Lanes>> stored(lines);
-    std::vector<std::int32_t> k0(lines, 0);
+    cache.lines_.resize(lines);
+    cache.lineK0_.assign(lines, 0);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, lines, 64), [&](const auto& range) {
         std::vector<Lanes> buffer(samplesPerLine);
         for (std::size_t line = range.begin(); line != range.end(); ++line) {
@@ -107,19 +106,17 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates,
             if (first == filled)
                 continue;
             first = first > 0 ? first - 1 : 0;
-            k0[line] = static_cast<std::int32_t>(first);
-            stored[line].assign(buffer.begin() + static_cast<std::ptrdiff_t>(first),
-                                buffer.begin() + static_cast<std::ptrdiff_t>(filled));
+            // Keep up to the first sample of the final value (unchanged after).
+            std::size_t last = filled;
+            while (last > first + 1 && std::equal(std::begin(buffer[last - 2].v),
+                                                  std::end(buffer[last - 2].v),
+                                                  std::begin(buffer[last - 1].v)))
+                --last;
+            cache.lineK0_[line] = static_cast<std::int32_t>(first);
+            cache.lines_[line].assign(buffer.begin() + static_cast<std::ptrdiff_t>(first),
+                                buffer.begin() + static_cast<std::ptrdiff_t>(last));
         }
     });
-    cache.lineStart_.resize(lines + 1, 0);
-    for (std::size_t line = 0; line < lines; ++line)
-        cache.lineStart_[line + 1] =
-            cache.lineStart_[line] + static_cast<std::uint32_t>(stored[line].size());
-    cache.samples_.reserve(cache.lineStart_.back());
-    for (std::size_t line = 0; line < lines; ++line)
-        cache.samples_.insert(cache.samples_.end(), stored[line].begin(), stored[line].end());
-    cache.lineK0_ = std::move(k0);
     return cache;
 }
 
@@ -144,19 +141,18 @@ Vec3f LightSpaceCache::lineOrigin(int i, int j, Vec3f& dir) const {
 }
 
 Lanes LightSpaceCache::alongLine(std::size_t line, float s) const {
-    const std::uint32_t begin = lineStart_[line], end = lineStart_[line + 1];
-    if (begin == end)
+    const std::vector<Lanes>& samples = lines_[line];
+    if (samples.empty())
         return {};
     const float local = s - float(lineK0_[line]);
     if (local <= 0)
-        return local <= -1.0f ? Lanes{} : samples_[begin]; // the first stored sample is the last zero
-    const auto count = end - begin;
-    const auto k = static_cast<std::uint32_t>(local);
-    if (k + 1 >= count)
-        return samples_[end - 1]; // past the volume or opaque: unchanged from here on
+        return local <= -1.0f ? Lanes{} : samples.front(); // the first stored sample is the last zero
+    const auto k = static_cast<std::size_t>(local);
+    if (k + 1 >= samples.size())
+        return samples.back(); // past the last brick or opaque: unchanged from here on
     const float t = local - float(k);
-    const Lanes& a = samples_[begin + k];
-    const Lanes& b = samples_[begin + k + 1];
+    const Lanes& a = samples[k];
+    const Lanes& b = samples[k + 1];
     Lanes r;
     for (int lane = 0; lane < 8; ++lane)
         r.v[lane] = a.v[lane] + t * (b.v[lane] - a.v[lane]);
@@ -181,11 +177,6 @@ OpticalDepths LightSpaceCache::lookup(const Vec3f& p) const {
             r.v[lane] += w * s.v[lane];
     }
     return r.depths();
-}
-
-std::size_t LightSpaceCache::memoryBytes() const {
-    return samples_.capacity() * sizeof(Lanes) + lineStart_.capacity() * sizeof(std::uint32_t) +
-           lineK0_.capacity() * sizeof(std::int32_t);
 }
 
 } // namespace hairvox::detail

@@ -5,8 +5,8 @@
 // or radiating from a point light that lies outside the volume's bounds (a
 // perspective lattice whose spacing is h at the volume's centre). Each line is
 // integrated exactly once, from the light side, and the running integral is
-// stored every h along it — only between the first brick it enters and the
-// point where it becomes opaque or leaves the volume (before: zero, after:
+// stored every h along it — only from the first brick it enters to the point
+// where it becomes opaque or leaves its last brick (before: zero, after:
 // unchanged). A query interpolates its 4 surrounding lines bilinearly and
 // each line linearly along its length. No value is interpolated twice, so
 // there is no blur that grows with the path; the error is the lattice's
@@ -35,9 +35,7 @@ public:
     /// The integral from p to the light.
     OpticalDepths lookup(const Vec3f& p) const;
 
-    std::size_t lineCount() const { return lineStart_.size() - 1; }
-    std::size_t sampleCount() const { return samples_.size(); }
-    std::size_t memoryBytes() const;
+    std::size_t lineCount() const { return lines_.size(); }
 
 private:
     /// Lattice coordinates of p: (u, v) across the lines, s along them (from the light).
@@ -54,9 +52,8 @@ private:
     float h_ = 1;                           ///< spacing along lines (world)
     float sBase_ = 0;                       ///< world distance of lattice s = 0 from the light plane/point
     int i0_ = 0, j0_ = 0, ni_ = 0, nj_ = 0; ///< line lattice [i0, i0 + ni) × [j0, j0 + nj)
-    std::vector<std::uint32_t> lineStart_;  ///< per line, offset of its first sample (+1 end)
     std::vector<std::int32_t> lineK0_;      ///< per line, lattice index of its first sample
-    std::vector<Lanes> samples_;
+    std::vector<std::vector<Lanes>> lines_; ///< per line, its stored samples (built in place)
 };
 
 } // namespace hairvox::detail
