@@ -7,7 +7,6 @@ namespace hairvox::cli {
 
 std::vector<CLI::Option*> FiberOptions::add(CLI::App* cmd) {
     std::vector<CLI::Option*> options;
-    const FiberParams d;
     options.push_back(cmd->add_option("--eta", eta, "Index of refraction [1.1, 2.5] (default 1.55)"));
     CLI::Option* sigma = cmd->add_option("--sigma-a", sigmaA,
                                          "Absorption per unit fiber radius r,g,b, each in [0, 50] "

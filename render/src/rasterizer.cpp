@@ -423,10 +423,10 @@ bool finiteNonNegative(float x) {
 bool isValid(const ShadeResult& r, std::span<const GlobalTerm> terms) {
     bool ok = true;
     for (const Rgb* c : {&r.directR, &r.directTT, &r.directTRT, &r.backDirect, &r.scatter})
-        ok &= finiteNonNegative(c->r) & finiteNonNegative(c->g) & finiteNonNegative(c->b);
+        ok = ok && finiteNonNegative(c->r) && finiteNonNegative(c->g) && finiteNonNegative(c->b);
     for (const GlobalTerm& g : terms)
-        ok &= std::isfinite(g.n) & std::isfinite(g.V) & g.P.isFinite() & g.T_s.isFinite() &
-              g.sigma2_f.isFinite();
+        ok = ok && std::isfinite(g.n) && std::isfinite(g.V) && g.P.isFinite() && g.T_s.isFinite() &&
+             g.sigma2_f.isFinite();
     return ok;
 }
 

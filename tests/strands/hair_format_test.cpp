@@ -13,7 +13,7 @@
 namespace hairvox {
 namespace {
 
-constexpr std::uint32_t kSegments = 1, kPoints = 2, kThickness = 4, kTransparency = 8, kColors = 16;
+constexpr std::uint32_t kSegments = 1, kPoints = 2, kThickness = 4, kColors = 16;
 
 /// A .hair header with the given counts and array bits (data appended by the caller).
 test::ByteWriter hairHeader(std::uint32_t strands, std::uint32_t points, std::uint32_t arrays,
