@@ -7,7 +7,8 @@ namespace hairvox::cli {
 
 std::vector<CLI::Option*> FiberOptions::add(CLI::App* cmd) {
     std::vector<CLI::Option*> options;
-    options.push_back(cmd->add_option("--eta", eta, "Index of refraction [1.1, 2.5] (default 1.55)"));
+    options.push_back(
+        cmd->add_option("--eta", eta, "Index of refraction [1.1, 2.5] (default 1.55)"));
     CLI::Option* sigma = cmd->add_option("--sigma-a", sigmaA,
                                          "Absorption per unit fiber radius r,g,b, each in [0, 50] "
                                          "(default 0.2,0.3,0.5)")
@@ -20,13 +21,16 @@ std::vector<CLI::Option*> FiberOptions::add(CLI::App* cmd) {
                           ->delimiter(',')
                           ->expected(2)
                           ->excludes(sigma));
-    options.push_back(cmd->add_option("--alpha-r", alphaRDeg, "R-lobe shift (deg) [-20, 20] (default -7.5)"));
-    options.push_back(cmd->add_option("--beta-r", betaRDeg, "R-lobe width (deg) [0.5, 45] (default 7.5)"));
+    options.push_back(
+        cmd->add_option("--alpha-r", alphaRDeg, "R-lobe shift (deg) [-20, 20] (default -7.5)"));
+    options.push_back(
+        cmd->add_option("--beta-r", betaRDeg, "R-lobe width (deg) [0.5, 45] (default 7.5)"));
     options.push_back(cmd->add_option("--eccentricity", eccentricity,
                                       "Cross-section eccentricity [0.5, 1] (default 1)"));
     options.push_back(cmd->add_option("--caustic-width", causticWidthDeg,
                                       "TRT caustic width w_c (deg) [1, 45] (default 15)"));
-    options.push_back(cmd->add_option("--caustic-gain", causticGain, "TRT caustic gain k_G [0, 10] (default 0.5)"));
+    options.push_back(cmd->add_option("--caustic-gain", causticGain,
+                                      "TRT caustic gain k_G [0, 10] (default 0.5)"));
     options.push_back(cmd->add_option("--caustic-fade", causticFade,
                                       "Caustic fade-out range [0.01, 1] (default 0.3)"));
     options.push_back(cmd->add_option("--caustic-max-width", causticMaxWidth,
@@ -75,7 +79,6 @@ void SceneInput::add(CLI::App* cmd) {
     cmd->add_option("--voxel-size", voxelSize, "Fiber grid voxel size (default: from the groom)")
         ->check(CLI::PositiveNumber);
 }
-
 
 Scene SceneInput::resolve() const {
     if (sceneFile.empty() && groomFile.empty())

@@ -10,17 +10,9 @@
 namespace hairvox {
 namespace {
 
-constexpr float kDiameter = 5e-5f; // with the default slab: n = 2 straight up
-
-CrossingTable constantTable(float aBar, float beta2) {
-    return CrossingTable::build([=](float) { return Rgb(aBar); }, [=](float) { return Rgb(beta2); });
-}
-
-GlobalTermSettings settings() {
-    GlobalTermSettings s;
-    s.fiberDiameter = kDiameter;
-    return s;
-}
+using test::constantTable;
+using test::slabSettings;
+constexpr float kDiameter = test::kSlabDiameter;
 
 GlobalTerm evaluateAt(const GlobalTermModel& model, const LightGeometry& light, const Vec3f& p,
                       const Vec3f& tangent = Vec3f(1, 0, 0)) {
@@ -40,7 +32,7 @@ void expectSlabMatchesPoissonClosedForms(float densityMultiplier) {
     ExactOptions options;
     options.rays = 64;
     options.radius = 0.004f;
-    GlobalTermSettings s = settings();
+    GlobalTermSettings s = slabSettings();
     s.densityMultiplier = densityMultiplier;
     const auto model = makeExactModel(groom, constantTable(aBar, 0.02f), s, options);
 
@@ -54,8 +46,9 @@ void expectSlabMatchesPoissonClosedForms(float densityMultiplier) {
         std::vector<GlobalTermQuery> queries;
         Pcg32 rng(5);
         for (int i = 0; i < 400; ++i)
-            queries.push_back({Vec3f(rng.uniform(-0.015f, 0.015f), -0.005f, rng.uniform(-0.08f, 0.08f)),
-                               Vec3f(1, 0, 0)});
+            queries.push_back(
+                {Vec3f(rng.uniform(-0.015f, 0.015f), -0.005f, rng.uniform(-0.08f, 0.08f)),
+                 Vec3f(1, 0, 0)});
         std::vector<GlobalTerm> out(queries.size());
         light->evaluate(queries, out);
         double n = 0, V = 0, P = 0, sigma2 = 0;
@@ -75,7 +68,9 @@ void expectSlabMatchesPoissonClosedForms(float densityMultiplier) {
     }
 }
 
-TEST(ExactGlobalTerm, SlabMatchesPoissonClosedForms) { expectSlabMatchesPoissonClosedForms(1.0f); }
+TEST(ExactGlobalTerm, SlabMatchesPoissonClosedForms) {
+    expectSlabMatchesPoissonClosedForms(1.0f);
+}
 
 // A modeled strand standing for k hairs is k hairs side by side (a ribbon k·D
 // wide), not k hairs stacked on one spot: V falls as e^{−k·n₁}, as the grid
@@ -87,7 +82,7 @@ TEST(ExactGlobalTerm, DensityMultiplierAddsIndependentHairs) {
 
 TEST(ExactGlobalTerm, EmptySpaceIsExactlyUnoccluded) {
     const test::Slab slab;
-    const auto model = makeExactModel(slab.groom(), constantTable(0.5f, 0.01f), settings(), {});
+    const auto model = makeExactModel(slab.groom(), constantTable(0.5f, 0.01f), slabSettings(), {});
     // Above the slab looking up, and beside it looking sideways: nothing in front.
     for (const auto& [p, dir] : {std::pair{Vec3f(0, 0.05f, 0), Vec3f(0, 1, 0)},
                                  std::pair{Vec3f(0, 0.005f, 0.2f), Vec3f(0, 0, 1)}}) {
@@ -107,7 +102,7 @@ TEST(ExactGlobalTerm, OwnFiberDoesNotShadowItself) {
     ExactOptions options;
     options.rays = 32;
     options.radius = 0.0005f;
-    const auto model = makeExactModel(groom, constantTable(0.5f, 0.01f), settings(), options);
+    const auto model = makeExactModel(groom, constantTable(0.5f, 0.01f), slabSettings(), options);
     for (float t : {0.1f, 0.5f, 0.99f}) {
         const Vec3f p = lerp(t, line[1], line[2]);
         for (const Vec3f dir :
@@ -123,10 +118,13 @@ TEST(ExactGlobalTerm, CurlComingBackCounts) {
     // A loop: the strand leaves the point along +x, turns, and crosses back
     // 2 mm above it; a light straight up sees that crossing, not its own fiber.
     Groom groom;
-    const Vec3f curl[5] = {{-0.01f, 0, 0}, {0.01f, 0, 0}, {0.01f, 0.002f, 0.0005f},
-                           {-0.01f, 0.002f, -0.0005f}, {-0.01f, 0.004f, 0}};
+    const Vec3f curl[5] = {{-0.01f, 0, 0},
+                           {0.01f, 0, 0},
+                           {0.01f, 0.002f, 0.0005f},
+                           {-0.01f, 0.002f, -0.0005f},
+                           {-0.01f, 0.004f, 0}};
     groom.addStrand(curl);
-    const auto model = makeExactModel(groom, constantTable(0.5f, 0.01f), settings(), {});
+    const auto model = makeExactModel(groom, constantTable(0.5f, 0.01f), slabSettings(), {});
     for (const std::uint32_t hint : {kUnknownStrand, 0u}) {
         GlobalTerm g;
         const GlobalTermQuery q{Vec3f(0, 0, 0), Vec3f(1, 0, 0), hint};
@@ -148,8 +146,11 @@ TEST(ExactGlobalTerm, JointOfTwoSegmentsIsOneCrossing) {
     EXPECT_NEAR(hits[0].t, 0.005f, 1e-4f);
     // A curl that loops back across the ray counts each time it crosses.
     Groom loop;
-    const Vec3f curl[5] = {{-0.01f, 0.002f, 0}, {0.01f, 0.002f, 0}, {0.01f, 0.004f, 0.0005f},
-                           {-0.01f, 0.004f, -0.0005f}, {-0.01f, 0.006f, 0.001f}};
+    const Vec3f curl[5] = {{-0.01f, 0.002f, 0},
+                           {0.01f, 0.002f, 0},
+                           {0.01f, 0.004f, 0.0005f},
+                           {-0.01f, 0.004f, -0.0005f},
+                           {-0.01f, 0.006f, 0.001f}};
     loop.addStrand(curl);
     StrandRayCaster(loop, kDiameter).crossings(Vec3f(0, 0, 0), Vec3f(0, 1, 0), 1.0f, hits);
     ASSERT_EQ(hits.size(), 2u);
@@ -165,7 +166,7 @@ TEST(ExactGlobalTerm, JointOfTwoSegmentsIsOneCrossing) {
 
 TEST(ExactGlobalTerm, OccluderBlocksLight) {
     const test::Slab slab;
-    GlobalTermSettings s = settings();
+    GlobalTermSettings s = slabSettings();
     s.occluder = Sphere{Vec3f(0, 0.05f, 0), 0.01f};
     const auto model = makeExactModel(slab.groom(), constantTable(0.5f, 0.01f), s, {});
     const auto light = model->forLight(LightGeometry::point(Vec3f(0, 0.1f, 0)));
@@ -184,7 +185,8 @@ TEST(ExactGlobalTerm, IndependentOfBatchingAndOrder) {
     ExactOptions options;
     options.rays = 8;
     options.radius = 0.002f;
-    const auto model = makeExactModel(slab.groom(), constantTable(0.5f, 0.01f), settings(), options);
+    const auto model =
+        makeExactModel(slab.groom(), constantTable(0.5f, 0.01f), slabSettings(), options);
     const auto light = model->forLight(LightGeometry::directional(Vec3f(0.3f, 1, 0.1f)));
     std::vector<GlobalTermQuery> queries;
     for (int i = 0; i < 50; ++i)
@@ -207,17 +209,16 @@ namespace {
 
 TEST(GlobalTermOccluder, PointLightInsideTheHeadReachesNothing) {
     const test::Slab slab;
-    GlobalTermSettings s = settings();
+    GlobalTermSettings s = slabSettings();
     s.occluder = Sphere{Vec3f(0, 0.05f, 0), 0.01f};
     const auto model = makeExactModel(slab.groom(), constantTable(0.5f, 0.01f), s, {});
     EXPECT_TRUE(model->forLight(LightGeometry::point(Vec3f(0, 0.052f, 0)))->blocksEverything());
     EXPECT_FALSE(model->forLight(LightGeometry::point(Vec3f(0, 0.1f, 0)))->blocksEverything());
     EXPECT_FALSE(model->forLight(LightGeometry::directional(Vec3f(0, 1, 0)))->blocksEverything());
     s.occluder.reset();
-    EXPECT_FALSE(
-        makeExactModel(slab.groom(), constantTable(0.5f, 0.01f), s, {})
-            ->forLight(LightGeometry::point(Vec3f(0, 0.052f, 0)))
-            ->blocksEverything());
+    EXPECT_FALSE(makeExactModel(slab.groom(), constantTable(0.5f, 0.01f), s, {})
+                     ->forLight(LightGeometry::point(Vec3f(0, 0.052f, 0)))
+                     ->blocksEverything());
 }
 
 } // namespace

@@ -11,17 +11,9 @@
 namespace hairvox {
 namespace {
 
-constexpr float kDiameter = 5e-5f; // with the default slab: n = 2 straight up
-
-CrossingTable constantTable(float aBar, float beta2) {
-    return CrossingTable::build([=](float) { return Rgb(aBar); }, [=](float) { return Rgb(beta2); });
-}
-
-GlobalTermSettings settings() {
-    GlobalTermSettings s;
-    s.fiberDiameter = kDiameter;
-    return s;
-}
+using test::constantTable;
+using test::slabSettings;
+constexpr float kDiameter = test::kSlabDiameter;
 
 FiberGrid splat(const Groom& groom, double voxelSize) {
     SplatOptions options;
@@ -35,11 +27,13 @@ TEST(GridGlobalTerm, SlabMatchesClosedForms) {
     const FiberGrid grid = splat(slab.groom(), 0.002);
     const float aBar = 0.55f;
     for (const OrientationModel model :
-         {OrientationModel::MeanTangent, OrientationModel::CoherenceBlend, OrientationModel::Tensor}) {
+         {OrientationModel::MeanTangent, OrientationModel::CoherenceBlend,
+          OrientationModel::Tensor}) {
         GridOptions options;
         options.orientation = model;
         options.startOffset = 0;
-        const auto gridModel = makeGridModel(grid, constantTable(aBar, 0.02f), settings(), options);
+        const auto gridModel =
+            makeGridModel(grid, constantTable(aBar, 0.02f), slabSettings(), options);
         for (const Vec3f dir : {Vec3f(0, 1, 0), Vec3f(0.5f, 1, 0), Vec3f(0, 1, 0.6f),
                                 Vec3f(-0.4f, 1, 0.4f), Vec3f(0.8f, 1, -0.2f)}) {
             const Vec3f omega = glm::normalize(dir);
@@ -47,9 +41,9 @@ TEST(GridGlobalTerm, SlabMatchesClosedForms) {
             std::vector<GlobalTermQuery> queries;
             Pcg32 rng(5);
             for (int i = 0; i < 200; ++i)
-                queries.push_back({Vec3f(rng.uniform(-0.015f, 0.015f), -0.005f,
-                                         rng.uniform(-0.08f, 0.08f)),
-                                   Vec3f(1, 0, 0)});
+                queries.push_back(
+                    {Vec3f(rng.uniform(-0.015f, 0.015f), -0.005f, rng.uniform(-0.08f, 0.08f)),
+                     Vec3f(1, 0, 0)});
             std::vector<GlobalTerm> out(queries.size());
             light->evaluate(queries, out);
             double n = 0, V = 0, P = 0;
@@ -73,7 +67,7 @@ TEST(GridGlobalTerm, EmptySpaceIsExactlyUnoccluded) {
     const test::Slab slab;
     const FiberGrid grid = splat(slab.groom(), 0.002);
     for (const auto make : {&makeGridModel, &makeApproxModel}) {
-        const auto model = make(grid, constantTable(0.5f, 0.01f), settings(), {});
+        const auto model = make(grid, constantTable(0.5f, 0.01f), slabSettings(), {});
         for (const auto& [p, dir] : {std::pair{Vec3f(0, 0.05f, 0), Vec3f(0, 1, 0)},
                                      std::pair{Vec3f(0, 0.005f, 0.2f), Vec3f(0, 0, 1)},
                                      std::pair{Vec3f(5, 5, 5), Vec3f(1, 1, 1)}}) {
@@ -98,7 +92,7 @@ TEST(GridGlobalTerm, CrossingCountIsSymmetric) {
     const FiberGrid grid = splat(slab.groom(), 0.002);
     GridOptions options;
     options.evaluation = GridEvaluation::March; // the integrator itself, no cache interpolation
-    const auto model = makeGridModel(grid, constantTable(0.5f, 0.01f), settings(), options);
+    const auto model = makeGridModel(grid, constantTable(0.5f, 0.01f), slabSettings(), options);
     Pcg32 rng(9);
     for (int i = 0; i < 16; ++i) {
         const Vec3f a(rng.uniform(-0.01f, 0.01f), -0.004f, rng.uniform(-0.05f, 0.05f));
@@ -121,11 +115,11 @@ TEST(GridGlobalTerm, PoissonKeepsTransmittanceNonNegativeWhereGeometricCannot) {
     const GlobalTermQuery q{Vec3f(0, -0.005f, 0), Vec3f(1, 0, 0)};
     GridOptions options;
     options.estimator = AttenuationEstimator::Poisson;
-    makeGridModel(grid, constantTable(0.2f, 0.01f), settings(), options)
+    makeGridModel(grid, constantTable(0.2f, 0.01f), slabSettings(), options)
         ->forLight(LightGeometry::directional(Vec3f(0, 1, 0)))
         ->evaluate({&q, 1}, {&poisson, 1});
     options.estimator = AttenuationEstimator::Geometric;
-    makeGridModel(grid, constantTable(0.2f, 0.01f), settings(), options)
+    makeGridModel(grid, constantTable(0.2f, 0.01f), slabSettings(), options)
         ->forLight(LightGeometry::directional(Vec3f(0, 1, 0)))
         ->evaluate({&q, 1}, {&geometric, 1});
     EXPECT_GT(poisson.T_s.r, 0.0f);

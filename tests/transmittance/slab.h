@@ -5,6 +5,8 @@
 
 #include <hairvox/core/rng.h>
 #include <hairvox/strands/groom.h>
+#include <hairvox/transmittance/crossing_table.h>
+#include <hairvox/transmittance/global_term_model.h>
 
 #include <cmath>
 
@@ -38,5 +40,22 @@ struct Slab {
         return g;
     }
 };
+
+/// The fiber diameter of the slab tests: with the default slab, n = 2 straight up.
+constexpr float kSlabDiameter = 5e-5f;
+
+/// Global-term settings of the slab tests (diameter kSlabDiameter, defaults otherwise).
+inline GlobalTermSettings slabSettings() {
+    GlobalTermSettings s;
+    s.fiberDiameter = kSlabDiameter;
+    return s;
+}
+
+/// A crossing table with the same ā_f and β̄_f² at every inclination, so the
+/// closed forms depend on the crossing count only.
+inline CrossingTable constantTable(float aBar, float beta2) {
+    return CrossingTable::build([=](float) { return Rgb(aBar); },
+                                [=](float) { return Rgb(beta2); });
+}
 
 } // namespace hairvox::test

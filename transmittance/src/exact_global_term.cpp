@@ -23,8 +23,8 @@ void ExactOptions::validate() const {
     if (rays < 1 || rays > 65536)
         throw InputError(strCat("exact mode: rays = ", rays, " should be in the range [1, 65536]"));
     if (!(radius >= 0 && radius < 1e3f))
-        throw InputError(strCat("exact mode: radius = ", radius,
-                                " should be in the range [0, 1000)"));
+        throw InputError(
+            strCat("exact mode: radius = ", radius, " should be in the range [0, 1000)"));
 }
 
 namespace {
@@ -108,7 +108,9 @@ private:
     };
     glm::ivec3 cell(const Vec3f& p) const { return glm::ivec3(glm::floor(p * invCell_)); }
     static std::uint64_t key(const glm::ivec3& c) {
-        const auto part = [](int v) { return static_cast<std::uint64_t>(v + (1 << 20)) & 0x1fffffu; };
+        const auto part = [](int v) {
+            return static_cast<std::uint64_t>(v + (1 << 20)) & 0x1fffffu;
+        };
         return part(c.x) | (part(c.y) << 21) | (part(c.z) << 42);
     }
 
@@ -121,10 +123,10 @@ private:
 struct StrandRayCaster::Impl {
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
-    std::vector<float> vertices;              ///< x, y, z, radius per point (+1 padding vertex)
-    std::vector<std::uint32_t> segmentStart;  ///< first vertex of each segment (Embree index buffer)
+    std::vector<float> vertices;             ///< x, y, z, radius per point (+1 padding vertex)
+    std::vector<std::uint32_t> segmentStart; ///< first vertex of each segment (Embree index buffer)
     std::vector<std::uint32_t> segmentStrand;
-    std::vector<float> segmentArcStart;       ///< arc length from the root to the segment start
+    std::vector<float> segmentArcStart; ///< arc length from the root to the segment start
     std::vector<Vec3f> segmentTangent;
     std::vector<std::uint32_t> strandFirstSegment; ///< per strand, plus one past the end
     mutable std::once_flag gridOnce;
@@ -152,8 +154,9 @@ struct StrandRayCaster::Impl {
 };
 
 StrandRayCaster::StrandRayCaster(const Groom& groom, float ribbonWidth, float locateDistance)
-    : impl_(std::make_unique<Impl>()), width_(ribbonWidth),
-      locateDistance_(locateDistance > 0 ? locateDistance : ribbonWidth) {
+    : impl_(std::make_unique<Impl>())
+    , width_(ribbonWidth)
+    , locateDistance_(locateDistance > 0 ? locateDistance : ribbonWidth) {
     Impl& m = *impl_;
     const float radius = 0.5f * ribbonWidth;
     m.vertices.reserve(4 * (groom.pointCount() + 1));
@@ -238,8 +241,9 @@ void StrandRayCaster::crossings(const Vec3f& origin, const Vec3f& dir, float tMa
     for (const RawHit& h : hits) {
         const std::uint32_t strand = m.segmentStrand[h.primID];
         const bool jointDuplicate = std::any_of(
-            out.rbegin(), std::find_if(out.rbegin(), out.rend(),
-                                       [&](const FiberCrossing& c) { return h.t - c.t > 2 * width_; }),
+            out.rbegin(),
+            std::find_if(out.rbegin(), out.rend(),
+                         [&](const FiberCrossing& c) { return h.t - c.t > 2 * width_; }),
             [&](const FiberCrossing& c) {
                 return c.strand == strand &&
                        (c.segment + 1 == h.primID || h.primID + 1 == c.segment);
@@ -293,7 +297,8 @@ class ExactModel;
 class ExactLightGlobalTerm final : public LightGlobalTerm {
 public:
     ExactLightGlobalTerm(const ExactModel& model, const LightGeometry& light)
-        : model_(model), light_(light) {}
+        : model_(model)
+        , light_(light) {}
     GlobalTermStats evaluate(std::span<const GlobalTermQuery> queries,
                              std::span<GlobalTerm> out) const override;
 
@@ -309,14 +314,15 @@ public:
     ExactModel(const Groom& groom, const CrossingTable& crossingTable,
                const GlobalTermSettings& globalSettings, const ExactOptions& exactOptions)
         : caster(groom, globalSettings.densityMultiplier * globalSettings.fiberDiameter,
-                 std::max(1.0f, globalSettings.densityMultiplier) * globalSettings.fiberDiameter),
-          crossings(crossingTable),
-          settings(globalSettings), options(exactOptions) {}
+                 std::max(1.0f, globalSettings.densityMultiplier) * globalSettings.fiberDiameter)
+        , crossings(crossingTable)
+        , settings(globalSettings)
+        , options(exactOptions) {}
 
     GlobalTermMode mode() const override { return GlobalTermMode::Exact; }
     std::unique_ptr<LightGlobalTerm> forLight(const LightGeometry& light) const override {
-        return withOccluder(std::make_unique<ExactLightGlobalTerm>(*this, light),
-                            settings.occluder, light);
+        return withOccluder(std::make_unique<ExactLightGlobalTerm>(*this, light), settings.occluder,
+                            light);
     }
 
     StrandRayCaster caster;
@@ -350,8 +356,8 @@ GlobalTerm ExactLightGlobalTerm::evaluateOne(const GlobalTermQuery& q,
     Rgbd pSum, beta2Sum;
     for (int ray = 0; ray < opt.rays; ++ray) {
         // Fibonacci spiral over the disk (uniform area density), randomly rotated.
-        const float rho = opt.radius * std::sqrt((static_cast<float>(ray) + 0.5f) /
-                                                 static_cast<float>(opt.rays));
+        const float rho =
+            opt.radius * std::sqrt((static_cast<float>(ray) + 0.5f) / static_cast<float>(opt.rays));
         const float phi = rotation + goldenAngle * static_cast<float>(ray);
         const Vec3f origin = q.position + rho * (std::cos(phi) * e1 + std::sin(phi) * e2);
         model_.caster.crossings(origin, path.omega, path.distance, hits);

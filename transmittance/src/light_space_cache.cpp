@@ -15,17 +15,16 @@ namespace {
 std::array<Vec3f, 8> corners(const Bounds3f& b) {
     std::array<Vec3f, 8> c;
     for (int k = 0; k < 8; ++k)
-        c[static_cast<std::size_t>(k)] = Vec3f((k & 4) ? b.max.x : b.min.x,
-                                               (k & 2) ? b.max.y : b.min.y,
-                                               (k & 1) ? b.max.z : b.min.z);
+        c[static_cast<std::size_t>(k)] = Vec3f(
+            (k & 4) ? b.max.x : b.min.x, (k & 2) ? b.max.y : b.min.y, (k & 1) ? b.max.z : b.min.z);
     return c;
 }
 
 } // namespace
 
 std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates,
-                                                      const LightGeometry& light,
-                                                      float opaqueDepth, float spacing) {
+                                                      const LightGeometry& light, float opaqueDepth,
+                                                      float spacing) {
     LightSpaceCache cache;
     cache.h_ = static_cast<float>(rates.voxelSize());
     const Bounds3f bounds = rates.bounds();
@@ -95,8 +94,9 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates,
         std::vector<Lanes> buffer(samplesPerLine);
         for (std::size_t line = range.begin(); line != range.end(); ++line) {
             Vec3f dir;
-            const Vec3f origin = cache.lineOrigin(static_cast<int>(line % std::size_t(cache.ni_)),
-                                                  static_cast<int>(line / std::size_t(cache.ni_)), dir);
+            const Vec3f origin =
+                cache.lineOrigin(static_cast<int>(line % std::size_t(cache.ni_)),
+                                 static_cast<int>(line / std::size_t(cache.ni_)), dir);
             const std::size_t filled =
                 rates.integrateCumulative(origin, dir, 0.0f, cache.h_, opaqueDepth, buffer);
             // Keep from the sample before the first non-zero one (zero before).
@@ -108,13 +108,13 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates,
             first = first > 0 ? first - 1 : 0;
             // Keep up to the first sample of the final value (unchanged after).
             std::size_t last = filled;
-            while (last > first + 1 && std::equal(std::begin(buffer[last - 2].v),
-                                                  std::end(buffer[last - 2].v),
-                                                  std::begin(buffer[last - 1].v)))
+            while (last > first + 1 &&
+                   std::equal(std::begin(buffer[last - 2].v), std::end(buffer[last - 2].v),
+                              std::begin(buffer[last - 1].v)))
                 --last;
             cache.lineK0_[line] = static_cast<std::int32_t>(first);
             cache.lines_[line].assign(buffer.begin() + static_cast<std::ptrdiff_t>(first),
-                                buffer.begin() + static_cast<std::ptrdiff_t>(last));
+                                      buffer.begin() + static_cast<std::ptrdiff_t>(last));
         }
     });
     return cache;
@@ -146,7 +146,8 @@ Lanes LightSpaceCache::alongLine(std::size_t line, float s) const {
         return {};
     const float local = s - float(lineK0_[line]);
     if (local <= 0)
-        return local <= -1.0f ? Lanes{} : samples.front(); // the first stored sample is the last zero
+        return local <= -1.0f ? Lanes{}
+                              : samples.front(); // the first stored sample is the last zero
     const auto k = static_cast<std::size_t>(local);
     if (k + 1 >= samples.size())
         return samples.back(); // past the last brick or opaque: unchanged from here on
@@ -172,7 +173,8 @@ OpticalDepths LightSpaceCache::lookup(const Vec3f& p) const {
         if (ii < 0 || jj < 0 || ii >= ni_ || jj >= nj_)
             continue;
         const float w = ((k & 1) ? tx : 1.0f - tx) * ((k >> 1) ? ty : 1.0f - ty);
-        const Lanes s = alongLine(static_cast<std::size_t>(jj) * std::size_t(ni_) + std::size_t(ii), l.z);
+        const Lanes s =
+            alongLine(static_cast<std::size_t>(jj) * std::size_t(ni_) + std::size_t(ii), l.z);
         for (int lane = 0; lane < 8; ++lane)
             r.v[lane] += w * s.v[lane];
     }

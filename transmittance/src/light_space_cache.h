@@ -28,9 +28,8 @@ public:
     /// Empty for a point light inside (or too close to) the volume's bounds,
     /// where a perspective lattice cannot cover it: queries then march.
     /// `spacing` is the distance between lines in voxels (along them: one voxel).
-    static std::optional<LightSpaceCache> build(const BrickVolume& rates,
-                                                const LightGeometry& light, float opaqueDepth,
-                                                float spacing);
+    static std::optional<LightSpaceCache>
+    build(const BrickVolume& rates, const LightGeometry& light, float opaqueDepth, float spacing);
 
     /// The integral from p to the light.
     OpticalDepths lookup(const Vec3f& p) const;
@@ -46,11 +45,11 @@ private:
     Lanes alongLine(std::size_t line, float s) const;
 
     bool perspective_ = false;
-    Vec3f origin_{0.0f};                    ///< light position (perspective) or 0
+    Vec3f origin_{0.0f};                              ///< light position (perspective) or 0
     Vec3f e1_{1, 0, 0}, e2_{0, 1, 0}, axis_{0, 0, 1}; ///< axis points away from the light
-    float du_ = 1;                          ///< lattice spacing across lines (world, or per unit depth)
-    float h_ = 1;                           ///< spacing along lines (world)
-    float sBase_ = 0;                       ///< world distance of lattice s = 0 from the light plane/point
+    float du_ = 1;    ///< lattice spacing across lines (world, or per unit depth)
+    float h_ = 1;     ///< spacing along lines (world)
+    float sBase_ = 0; ///< world distance of lattice s = 0 from the light plane/point
     int i0_ = 0, j0_ = 0, ni_ = 0, nj_ = 0; ///< line lattice [i0, i0 + ni) × [j0, j0 + nj)
     std::vector<std::int32_t> lineK0_;      ///< per line, lattice index of its first sample
     std::vector<std::vector<Lanes>> lines_; ///< per line, its stored samples (built in place)

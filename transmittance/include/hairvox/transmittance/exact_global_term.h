@@ -12,8 +12,8 @@
 // All hits along a shadow ray are collected (a context filter rejects every
 // hit, so traversal continues), sorted, and deduplicated: Embree can report
 // the same primitive twice, and a ray through the joint of two segments of one
-// strand hits both ribbons. For one ray crossing fibers k = 1..m:
-//   V = [m = 0],  P = ∏ ā_f(θ_k),  σ_f² = Σ β̄_f²(θ_k),  T_s = d_f (P − V).
+// strand hits both ribbons. For one ray crossing fibers j = 1..m:
+//   V = [m = 0],  P = ∏ ā_f(θ_j),  σ_f² = Σ β̄_f²(θ_j),  T_s = d_f (P − V).
 // With K rays whose origins are spread over a disk of radius r perpendicular
 // to the light, the global term is the mean over rays (σ_f² over the rays that
 // crossed something, matching the grid's conditioning).
@@ -38,8 +38,8 @@
 namespace hairvox {
 
 struct ExactOptions {
-    int rays = 1;          ///< K shadow rays per point, [1, 65536]
-    float radius = 0;      ///< r: ray origins spread over a disk of this radius, ⊥ to ω
+    int rays = 1;     ///< K shadow rays per point, [1, 65536]
+    float radius = 0; ///< r: ray origins spread over a disk of this radius, ⊥ to ω
     std::uint64_t seed = 1;
 
     void validate() const;
@@ -47,7 +47,7 @@ struct ExactOptions {
 
 /// One fiber crossed by a shadow ray.
 struct FiberCrossing {
-    float t;               ///< distance along the ray
+    float t; ///< distance along the ray
     std::uint32_t strand;
     std::uint32_t segment; ///< global segment index (Embree primitive)
     float arcLength;       ///< position of the crossing along its strand, from the root
