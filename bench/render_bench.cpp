@@ -1,6 +1,6 @@
 // hairvox render benchmarks: rasterizer throughput with a trivial shader.
 //
-// Printed figures (never asserted): wall time of renderImage() and its split
+// Printed figures (never asserted): wall time of rasterize() and its split
 // (setup = tangents + projection + binning, raster = raster/sort/composite,
 // shade = shader calls + accumulation), fragment counts, and the process's
 // peak resident memory. The shading here is a constant, so "shade" is the
@@ -9,9 +9,11 @@
 // 1.4M segments at 1920×1080 ≤ 10 s end to end and ≤ 2 GiB).
 //
 //   render_bench                                   # everything
-//   render_bench --benchmark_filter=Head1080p      # the 1.4M-segment case alone (clean peak memory)
-#include <hairvox/render/output.h>
-#include <hairvox/render/render.h>
+//   render_bench --benchmark_filter=Head1080p      # the 1.4M-segment case alone (clean peak
+//   memory)
+#include <hairvox/film/image_file.h>
+#include <hairvox/pipeline/pipeline.h>
+#include <hairvox/render/rasterizer.h>
 #include <hairvox/strands/procedural.h>
 
 #include <benchmark/benchmark.h>
@@ -23,20 +25,27 @@
 namespace hairvox {
 namespace {
 
-/// The cheapest valid shader: a constant per lobe.
+/// The cheapest valid shader: constants, in the layers of a real render (the
+/// dual-scattering shader's five radiance layers and per light V, n, T_s, σ_f).
 class ConstantShader : public FragmentShader {
 public:
-    void shade(std::span<const ShadingPoint> points, std::span<ShadeResult> radiance,
-               std::span<GlobalTerm> terms) const override {
-        ShadeResult r;
-        r.directR = Rgb(0.3f, 0.25f, 0.2f);
-        r.directTT = Rgb(0.2f, 0.15f, 0.1f);
-        r.scatter = Rgb(0.1f, 0.08f, 0.05f);
-        for (std::size_t i = 0; i < points.size(); ++i)
-            radiance[i] = r;
-        for (GlobalTerm& g : terms)
-            g = GlobalTerm::unoccluded();
+    explicit ConstantShader(const std::vector<Light>& lights) {
+        layout_.radiance = {"direct_R", "direct_TT", "direct_TRT", "back_direct", "scatter"};
+        for (const Light& l : lights)
+            for (const auto& [name, channels] : {std::pair{".V", 1}, std::pair{".n", 1},
+                                                 std::pair{".T_s", 3}, std::pair{".sigma_f", 3}})
+                layout_.averages.push_back({l.name + name, channels});
     }
+    const ShaderLayout& layout() const override { return layout_; }
+    void shade(std::span<const ShadingPoint> points, std::span<float> out) const override {
+        const std::size_t stride = layout_.stride();
+        for (std::size_t i = 0; i < points.size(); ++i)
+            for (std::size_t k = 0; k < stride; ++k)
+                out[i * stride + k] = 0.1f + 0.01f * float(k);
+    }
+
+private:
+    ShaderLayout layout_;
 };
 
 double peakResidentMiB() {
@@ -45,8 +54,8 @@ double peakResidentMiB() {
     return double(usage.ru_maxrss) / 1024.0; // ru_maxrss is in KiB on Linux
 }
 
-void report(benchmark::State& state, const RenderOutput& out) {
-    const RenderStats& s = out.stats;
+void report(benchmark::State& state, const RasterOutput& out) {
+    const RasterStats& s = out.stats;
     state.counters["setup_s"] = s.setupSeconds;
     state.counters["raster_s"] = s.rasterSeconds;
     state.counters["shade_s"] = s.shadeSeconds;
@@ -55,7 +64,7 @@ void report(benchmark::State& state, const RenderOutput& out) {
     state.counters["composited"] = double(s.fragmentsComposited);
     state.counters["behind_opaque"] = double(s.fragmentsBehindOpaque);
     state.counters["shading_points"] = double(s.shadingPoints);
-    state.counters["behind_head"] = double(s.segmentsBehindHead);
+    state.counters["behind_surfaces"] = double(s.segmentTilesBehindSurfaces);
     state.counters["peak_MiB"] = peakResidentMiB();
 }
 
@@ -64,10 +73,10 @@ void BM_RenderDefaultScene(benchmark::State& state) {
     Scene scene = defaultScene();
     scene.shadingRate = state.range(0) == 0 ? ShadingRate::Fragment : ShadingRate::Vertex;
     const Groom groom = generateGroom(scene.groom.procedural);
-    const ConstantShader shader;
-    RenderOutput out;
+    const ConstantShader shader(scene.lights);
+    RasterOutput out;
     for (auto _ : state)
-        out = renderImage(groom, scene, shader);
+        out = rasterize(groom, Camera(scene.camera), shader, rasterSettings(scene));
     report(state, out);
 }
 BENCHMARK(BM_RenderDefaultScene)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
@@ -82,10 +91,10 @@ void BM_RenderHead1080p(benchmark::State& state) {
     params.strands = 50000;
     params.pointsPerStrand = 29;
     const Groom groom = generateGroom(params);
-    const ConstantShader shader;
-    RenderOutput out;
+    const ConstantShader shader(scene.lights);
+    RasterOutput out;
     for (auto _ : state)
-        out = renderImage(groom, scene, shader);
+        out = rasterize(groom, Camera(scene.camera), shader, rasterSettings(scene));
     report(state, out);
 }
 BENCHMARK(BM_RenderHead1080p)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
@@ -94,15 +103,17 @@ BENCHMARK(BM_RenderHead1080p)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Us
 void BM_WriteOutput(benchmark::State& state) {
     const Scene scene = defaultScene();
     const Groom groom = generateGroom(scene.groom.procedural);
-    const RenderOutput out = renderImage(groom, scene, ConstantShader());
+    const RasterOutput out =
+        rasterize(groom, Camera(scene.camera), ConstantShader(scene.lights), rasterSettings(scene));
     const auto dir = std::filesystem::temp_directory_path() /
                      ("hairvox-render-bench-" + std::to_string(::getpid()));
     const auto path = dir / (state.range(0) == 0 ? "default.exr" : "default.png");
     for (auto _ : state) {
         if (state.range(0) == 0)
-            writeExr(path, out.film, Camera(scene.camera));
+            writeExr(path, out.film);
         else
-            writePng(path, out.film, scene.output.exposure, scene.output.toneMap);
+            writePng(path, out.film.width(), out.film.height(),
+                     previewPixels(out.film, scene.output.exposure, scene.output.toneMap));
     }
     state.counters["MiB"] = double(std::filesystem::file_size(path)) / 1048576.0;
     std::filesystem::remove_all(dir);

@@ -33,13 +33,13 @@
 namespace hairvox {
 namespace {
 
-const LightGeometry kLight = LightGeometry::directional(Vec3f(-0.6f, 0.65f, -0.45f));
+const Light kLight = Light::directional(Vec3f(-0.6f, 0.65f, -0.45f));
 
 struct Fixture {
     Groom groom;
     FiberGrid grid;
-    CrossingTable crossings = CrossingTable::build([](float) { return Rgb(1.0f); },
-                                                   [](float) { return Rgb(0.0f); });
+    CrossingTable crossings =
+        CrossingTable::build([](float) { return Rgb(1.0f); }, [](float) { return Rgb(0.0f); });
     GlobalTermSettings settings;
     std::vector<GlobalTermQuery> points;
 
@@ -55,7 +55,7 @@ struct Fixture {
             const auto cache = std::filesystem::temp_directory_path() / "hairvox-bench-tables";
             x.crossings = CrossingTable::fromDualScattering(
                 DualScatteringTables::loadOrBuild(FiberParams{}, cache));
-            x.settings.fiberDiameter = 7e-5f;
+            x.settings.fiberScale.diameter = 7e-5f;
             x.points = sampleFiberPoints(x.groom, 4'150'000, 1);
             return x;
         }();
@@ -81,8 +81,9 @@ void queries(benchmark::State& state, const GlobalTermModel& model, std::size_t 
     for (auto _ : state)
         light->evaluate(points, out);
     state.SetItemsProcessed(state.iterations() * static_cast<benchmark::IterationCount>(count));
-    state.counters["us_per_query"] = benchmark::Counter(
-        double(count) * 1e-6, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+    state.counters["us_per_query"] =
+        benchmark::Counter(double(count) * 1e-6, benchmark::Counter::kIsIterationInvariantRate |
+                                                     benchmark::Counter::kInvert);
 }
 
 void GridLookup(benchmark::State& state) {
@@ -107,7 +108,13 @@ void ExactRays(benchmark::State& state) {
     const auto model = makeExactModel(f.groom, f.crossings, f.settings, options);
     queries(state, *model, std::size_t(2000 * 16 / options.rays + 16));
 }
-BENCHMARK(ExactRays)->Arg(1)->Arg(16)->Arg(256)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK(ExactRays)
+    ->Arg(1)
+    ->Arg(16)
+    ->Arg(256)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
 
 void FrameGlobalTerm(benchmark::State& state) {
     const Fixture& f = Fixture::get();
@@ -121,7 +128,12 @@ void FrameGlobalTerm(benchmark::State& state) {
     }
     state.counters["queries"] = double(count);
 }
-BENCHMARK(FrameGlobalTerm)->Arg(4'150'000)->Arg(619'000)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK(FrameGlobalTerm)
+    ->Arg(4'150'000)
+    ->Arg(619'000)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(2);
 
 void ProbeAccuracy(benchmark::State& state) {
     const Fixture& f = Fixture::get();
@@ -136,10 +148,12 @@ void ProbeAccuracy(benchmark::State& state) {
     for (auto _ : state) {
         ProbeError g, a;
         for (const Vec3f& l : lights) {
-            const LightGeometry light = LightGeometry::directional(l);
+            const Light light = Light::directional(l);
             const std::vector<GlobalTerm> reference = evaluateGlobalTerm(*exact, light, points);
-            const ProbeError eg = compareGlobalTerms(evaluateGlobalTerm(*grid, light, points), reference);
-            const ProbeError ea = compareGlobalTerms(evaluateGlobalTerm(*approx, light, points), reference);
+            const ProbeError eg =
+                compareGlobalTerms(evaluateGlobalTerm(*grid, light, points), reference);
+            const ProbeError ea =
+                compareGlobalTerms(evaluateGlobalTerm(*approx, light, points), reference);
             g.maeV += eg.maeV / 3;
             g.maeT_s += eg.maeT_s / 3;
             a.maeV += ea.maeV / 3;

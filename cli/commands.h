@@ -6,6 +6,7 @@
 namespace hairvox::cli {
 
 void addBenchCommand(CLI::App& app);
+void addCompareCommand(CLI::App& app);
 void addGenerateCommand(CLI::App& app);
 void addInfoCommand(CLI::App& app);
 void addProbeCommand(CLI::App& app);

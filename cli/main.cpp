@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
     app.set_version_flag("--version", std::string(hairvox::version()));
     app.require_subcommand(1, 1);
     hairvox::cli::addBenchCommand(app);
+    hairvox::cli::addCompareCommand(app);
     hairvox::cli::addGenerateCommand(app);
     hairvox::cli::addInfoCommand(app);
     hairvox::cli::addProbeCommand(app);

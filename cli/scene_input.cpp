@@ -90,14 +90,13 @@ Scene SceneInput::resolve() const {
         scene = defaultScene();
         scene.name = groomFile;
         scene.head.reset();
-        scene.fiberDiameter = Scene{}.fiberDiameter;
-        scene.densityMultiplier = Scene{}.densityMultiplier;
+        scene.fiberScale = FiberScale{};
         scene.groom.file = groomFile;
         scene.fiber = fiber.apply(scene.fiber);
         if (diameter)
-            scene.fiberDiameter = *diameter;
+            scene.fiberScale.diameter = *diameter;
         if (densityMultiplier)
-            scene.densityMultiplier = *densityMultiplier;
+            scene.fiberScale.densityMultiplier = *densityMultiplier;
     }
     if (voxelSize)
         scene.voxelSize = *voxelSize;

@@ -3,7 +3,7 @@
 // degrees on the command line) — shared by tables, probe and transmittance.
 #pragma once
 
-#include <hairvox/render/scene.h>
+#include <hairvox/pipeline/scene.h>
 #include <hairvox/shading/fiber_params.h>
 
 #include <CLI/CLI.hpp>

@@ -5,7 +5,7 @@
 // prints itself. Anything else — a crash, a sanitizer report, another exception
 // type — is a finding.
 #include <hairvox/core/error.h>
-#include <hairvox/render/scene.h>
+#include <hairvox/pipeline/scene.h>
 
 #include <cstddef>
 #include <cstdint>

@@ -6,7 +6,7 @@
 # png_image_write_to_file, openvdb::io::File::write).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-dirs=(core strands shading voxelize transmittance render cli)
+dirs=(core strands geometry shading voxelize transmittance film render pipeline bench/sweep cli)
 opens='std::ofstream [A-Za-z_]+\(|std::fstream|fopen\(|OutputFile [A-Za-z_]+\(|png_image_write_to_file\(|io::File [A-Za-z_]+\('
 bad=$(grep -rnE "$opens" "${dirs[@]}" --include='*.cpp' --include='*.h' |
       grep -vE "\((&image, )?tmp[.,)]" || true)

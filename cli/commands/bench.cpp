@@ -1,13 +1,13 @@
 // hairvox bench [--scene FILE ...] [--out DIR] [--quick] [--threads N] [--runs N] [--no-scaling]
 // Sweeps global-term mode × voxel size × shading rate against exact-mode
 // references, then time and memory against segment count and image size
-// (render/bench_sweep.h); writes results.csv, results.md and PNG plots.
+// (bench/sweep); writes results.csv, results.md and PNG plots.
 // `hairvox bench --one JOB.json` is the worker that runs one job of a sweep in
 // its own process (so that its peak memory is its own).
 #include "../commands.h"
 
+#include <hairvox/bench/sweep.h>
 #include <hairvox/core/error.h>
-#include <hairvox/render/bench_sweep.h>
 
 #include <filesystem>
 #include <iostream>
@@ -52,8 +52,8 @@ void runBench(const BenchOptions& opt) {
         runBenchJobFile(opt.job);
         return;
     }
-    SweepOptions sweep = opt.quick ? SweepOptions::quick()
-                                   : SweepOptions::full("data/scenes/ratboy_mohawk.json");
+    SweepOptions sweep =
+        opt.quick ? SweepOptions::quick() : SweepOptions::full("data/scenes/ratboy_mohawk.json");
     if (!opt.scenes.empty()) {
         sweep.scenes.clear();
         for (const std::string& file : opt.scenes) {

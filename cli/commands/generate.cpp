@@ -1,8 +1,9 @@
-// hairvox generate straight|wavy|curly -o FILE.hair [--strands N] [--points-per-strand M] [--seed S]
+// hairvox generate straight|wavy|curly -o FILE.hair [--strands N] [--points-per-strand M] [--seed
+// S]
 #include "../commands.h"
-#include <hairvox/core/format.h>
 
 #include <hairvox/core/error.h>
+#include <hairvox/core/format.h>
 #include <hairvox/strands/groom_io.h>
 #include <hairvox/strands/procedural.h>
 
@@ -21,7 +22,7 @@ struct GenerateOptions {
 
 void runGenerate(const GenerateOptions& opt) {
     ProceduralGroomParams params = opt.params;
-    params.style = *parseGroomStyle(opt.style); // CLI11 checked the choice
+    params.style = *kGroomStyleNames.parse(opt.style); // CLI11 checked the choice
     const Groom groom = generateGroom(params);
     writeHairFile(opt.output, groom, strCat("hairvox generate ", opt.style));
     std::cout << "wrote " << opt.output << ": " << thousands(groom.strandCount()) << " "
@@ -35,7 +36,7 @@ void addGenerateCommand(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("generate", "Generate a procedural groom on a head sphere");
     cmd->add_option("style", opt->style, "Hair style")
         ->required()
-        ->check(CLI::IsMember({"straight", "wavy", "curly"}));
+        ->check(CLI::IsMember(kGroomStyleNames.names()));
     cmd->add_option("-o,--output", opt->output, "Output .hair file")->required();
     cmd->add_option("--strands", opt->params.strands, "Number of strands")
         ->capture_default_str()

@@ -9,7 +9,7 @@
 #include "../scene_input.h"
 
 #include <hairvox/core/parallel.h>
-#include <hairvox/render/pipeline.h>
+#include <hairvox/pipeline/pipeline.h>
 #include <hairvox/transmittance/probe.h>
 
 #include <chrono>
@@ -47,14 +47,14 @@ void runProbe(const ProbeOptions& opt) {
         const std::vector<GlobalTermQuery> points =
             sampleFiberPoints(groom, *opt.samplePoints, opt.seed);
         writeProbePoints(opt.output, points);
-        std::cout << "wrote " << opt.output << ": " << points.size()
-                  << " points on the fibers of " << scene.name << "\n";
+        std::cout << "wrote " << opt.output << ": " << points.size() << " points on the fibers of "
+                  << scene.name << "\n";
         return;
     }
     if (opt.points.empty())
         throw InputError("give --points IN.csv (or --sample-points N to make one)");
-    const LightGeometry light = opt.light.resolve();
-    scene.globalTermMode = *parseGlobalTermMode(opt.mode); // CLI11 checked the choice
+    const Light light = opt.light.resolve();
+    scene.globalTermMode = *kGlobalTermModeNames.parse(opt.mode); // CLI11 checked the choice
     if (opt.rays)
         scene.exact.rays = *opt.rays;
     if (opt.radius)
@@ -67,8 +67,8 @@ void runProbe(const ProbeOptions& opt) {
     options.threads = opt.threads;
     // A grid-mode cache costs a fixed ~0.1–1 s per light; a march ~20–40 µs per
     // point (transmittance_bench): below ~20,000 points marching is faster.
-    const bool march = opt.evaluation == "march" ||
-                       (opt.evaluation == "auto" && points.size() < 20'000);
+    const bool march =
+        opt.evaluation == "march" || (opt.evaluation == "auto" && points.size() < 20'000);
     options.grid.evaluation = march ? GridEvaluation::March : GridEvaluation::Cache;
     const std::unique_ptr<SceneAssets> assets = loadSceneAssets(scene, options);
     const auto evaluateStart = std::chrono::steady_clock::now();
@@ -81,8 +81,8 @@ void runProbe(const ProbeOptions& opt) {
         meanV += double(g.V) / double(terms.size());
         meanN += double(g.n) / double(terms.size());
     }
-    std::printf("wrote %s: %zu points, %s mode, mean n = %.4g, mean V = %.4g\n",
-                opt.output.c_str(), points.size(), toString(scene.globalTermMode), meanN, meanV);
+    std::printf("wrote %s: %zu points, %s mode, mean n = %.4g, mean V = %.4g\n", opt.output.c_str(),
+                points.size(), toString(scene.globalTermMode), meanN, meanV);
     std::printf("time: prepare %.3f s, evaluate %.3f s\n",
                 std::chrono::duration<double>(evaluateStart - start).count(),
                 std::chrono::duration<double>(end - evaluateStart).count());
@@ -95,8 +95,8 @@ void addProbeCommand(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand(
         "probe", "Global term (n, V, P, T_s, sigma_f^2) toward one light at points on fibers");
     opt->input.add(cmd);
-    CLI::Option* points = cmd->add_option("--points", opt->points,
-                                          "Input CSV x,y,z,tx,ty,tz[,strand]");
+    CLI::Option* points =
+        cmd->add_option("--points", opt->points, "Input CSV x,y,z,tx,ty,tz[,strand]");
     cmd->add_option("--sample-points", opt->samplePoints,
                     "Instead: write N random points on the fibers to -o")
         ->check(CLI::Range(std::size_t(1), std::size_t(100'000'000)))
@@ -105,7 +105,7 @@ void addProbeCommand(CLI::App& app) {
     opt->light.add(cmd);
     cmd->add_option("--mode", opt->mode, "Global-term mode")
         ->capture_default_str()
-        ->check(CLI::IsMember({"exact", "grid", "approx"}));
+        ->check(CLI::IsMember(kGlobalTermModeNames.names()));
     cmd->add_option("--evaluation", opt->evaluation,
                     "Grid/approx: per-light cache or one march per point (auto: march below "
                     "20,000 points)")
@@ -114,7 +114,8 @@ void addProbeCommand(CLI::App& app) {
     cmd->add_option("--rays", opt->rays, "Exact mode: rays per point K [1, 65536]");
     cmd->add_option("--radius", opt->radius,
                     "Exact mode: ray origins spread over a disk of this radius");
-    cmd->add_option("--threads", opt->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
+    cmd->add_option("--threads", opt->threads, "Threads (0: all cores)")
+        ->check(CLI::Range(0, 1024));
     cmd->add_option("-o,--output", opt->output, "Output CSV")->required();
     cmd->callback([opt] { runProbe(*opt); });
 }

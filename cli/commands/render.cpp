@@ -6,11 +6,11 @@
 
 #include <hairvox/core/error.h>
 #include <hairvox/core/progress.h>
-#include <hairvox/render/pipeline.h>
+#include <hairvox/pipeline/pipeline.h>
 
+#include <cstdint>
 #include <iostream>
 #include <memory>
-#include <cstdint>
 #include <optional>
 
 namespace hairvox::cli {
@@ -30,7 +30,7 @@ struct RenderCommandOptions {
 void runRender(const RenderCommandOptions& opt) {
     Scene scene = opt.scene.empty() ? defaultScene() : loadScene(opt.scene);
     if (!opt.mode.empty())
-        scene.globalTermMode = *parseGlobalTermMode(opt.mode); // CLI11 checked the choice
+        scene.globalTermMode = *kGlobalTermModeNames.parse(opt.mode); // CLI11 checked the choice
     if (opt.width)
         scene.camera.width = *opt.width;
     if (opt.height)
@@ -60,14 +60,17 @@ void runRender(const RenderCommandOptions& opt) {
 void addRenderCommand(CLI::App& app) {
     auto opt = std::make_shared<RenderCommandOptions>();
     CLI::App* cmd = app.add_subcommand(
-        "render", "Render a scene (default: the embedded default scene) to EXR with AOVs and a PNG");
-    cmd->add_option("scene", opt->scene, "Scene JSON file (docs/scene.md); omit for the default scene");
+        "render",
+        "Render a scene (default: the embedded default scene) to EXR with AOVs and a PNG");
+    cmd->add_option("scene", opt->scene,
+                    "Scene JSON file (docs/scene.md); omit for the default scene");
     cmd->add_option("-o,--output", opt->output,
                     "Output EXR (the PNG preview goes beside it); default: the scene's outputs");
     cmd->add_option("--mode", opt->mode, "Global-term mode")
-        ->check(CLI::IsMember({"exact", "grid", "approx"}));
+        ->check(CLI::IsMember(kGlobalTermModeNames.names()));
     cmd->add_option("--width", opt->width, "Image width in pixels")->check(CLI::Range(1u, 8192u));
-    cmd->add_option("--height", opt->height, "Image height in pixels")->check(CLI::Range(1u, 8192u));
+    cmd->add_option("--height", opt->height, "Image height in pixels")
+        ->check(CLI::Range(1u, 8192u));
     cmd->add_option("--voxel-size", opt->voxelSize, "Fiber grid voxel size (scene units)")
         ->check(CLI::PositiveNumber);
     cmd->add_option("--threads", opt->threads, "Worker threads (0: all cores)")

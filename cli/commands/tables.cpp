@@ -5,7 +5,7 @@
 #include "../commands.h"
 #include "../scene_input.h"
 
-#include <hairvox/render/scene.h>
+#include <hairvox/pipeline/scene.h>
 #include <hairvox/shading/dual_scattering_tables.h>
 
 #include <chrono>
@@ -42,12 +42,14 @@ void runTables(const TablesOptions& opt) {
     const auto start = std::chrono::steady_clock::now();
     const std::filesystem::path cacheDir =
         opt.cacheDir.empty() ? defaultTableCacheDir() : std::filesystem::path(opt.cacheDir);
-    const DualScatteringTables tables = DualScatteringTables::loadOrBuild(params, cacheDir, options);
+    const DualScatteringTables tables =
+        DualScatteringTables::loadOrBuild(params, cacheDir, options);
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     tables.writeCsv(opt.output);
 
-    const std::string cacheFile = DualScatteringTables::cacheFile(cacheDir, params, options).string();
+    const std::string cacheFile =
+        DualScatteringTables::cacheFile(cacheDir, params, options).string();
     std::cout << "wrote " << opt.output << ": " << tables.size()
               << " theta samples over [-90, 90] deg for " << params << "\n";
     if (tables.loadedFromCache())
@@ -63,8 +65,8 @@ void addTablesCommand(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand(
         "tables", "Write the dual-scattering tables of a hair fiber as CSV (one row per theta)");
     cmd->add_option("-o,--output", opt->output, "Output CSV file")->required();
-    CLI::Option* scene =
-        cmd->add_option("--scene", opt->sceneFile, "Take the fiber optics and d_b from a scene file");
+    CLI::Option* scene = cmd->add_option("--scene", opt->sceneFile,
+                                         "Take the fiber optics and d_b from a scene file");
     for (CLI::Option* o : opt->fiber.add(cmd))
         o->excludes(scene);
     cmd->add_option("--d-b", opt->d_b, "Backward density factor in sigma2b [0, 1]")

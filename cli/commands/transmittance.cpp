@@ -9,7 +9,7 @@
 
 #include <hairvox/core/error.h>
 #include <hairvox/core/parallel.h>
-#include <hairvox/render/pipeline.h>
+#include <hairvox/pipeline/pipeline.h>
 #include <hairvox/transmittance/lit_grid.h>
 
 #include <chrono>
@@ -29,7 +29,7 @@ struct TransmittanceOptions {
     int threads = 0;
 };
 
-std::string describe(const LightGeometry& light) {
+std::string describe(const Light& light) {
     std::ostringstream os;
     os << light;
     return os.str();
@@ -37,8 +37,8 @@ std::string describe(const LightGeometry& light) {
 
 void runTransmittance(const TransmittanceOptions& opt) {
     Scene scene = opt.input.resolve();
-    const LightGeometry light = opt.light.resolve();
-    scene.globalTermMode = *parseGlobalTermMode(opt.mode); // CLI11 checked the choice
+    const Light light = opt.light.resolve();
+    scene.globalTermMode = *kGlobalTermModeNames.parse(opt.mode); // CLI11 checked the choice
     const ThreadLimit threadLimit(opt.threads);
     const auto start = std::chrono::steady_clock::now();
     PipelineOptions options;
@@ -47,8 +47,7 @@ void runTransmittance(const TransmittanceOptions& opt) {
     if (!assets->grid) { // exact mode builds no grid: the voxels to query come from one
         SplatOptions splat;
         splat.voxelSize = scene.voxelSize.value_or(0.0f);
-        splat.fiberDiameter = scene.fiberDiameter;
-        splat.densityScale = scene.densityMultiplier;
+        splat.fiberScale = scene.fiberScale;
         splat.sourceFile = scene.groom.file.string();
         assets->grid = splatStrands(assets->groom, splat);
     }
@@ -66,9 +65,10 @@ void runTransmittance(const TransmittanceOptions& opt) {
                 opt.output.c_str(), toString(scene.globalTermMode),
                 static_cast<unsigned long long>(lit.stats.queries), info.voxelSize,
                 describe(light).c_str());
-    std::printf("time: %.3f s (write %.3f s)\n",
-                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
-                std::chrono::duration<double>(std::chrono::steady_clock::now() - evaluated).count());
+    std::printf(
+        "time: %.3f s (write %.3f s)\n",
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - evaluated).count());
 }
 
 } // namespace
@@ -82,8 +82,9 @@ void addTransmittanceCommand(CLI::App& app) {
     opt->light.add(cmd);
     cmd->add_option("--mode", opt->mode, "Global-term mode")
         ->capture_default_str()
-        ->check(CLI::IsMember({"exact", "grid", "approx"}));
-    cmd->add_option("--threads", opt->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
+        ->check(CLI::IsMember(kGlobalTermModeNames.names()));
+    cmd->add_option("--threads", opt->threads, "Threads (0: all cores)")
+        ->check(CLI::Range(0, 1024));
     cmd->add_option("-o,--output", opt->output, "Output .vdb")->required();
     cmd->callback([opt] { runTransmittance(*opt); });
 }

@@ -1,9 +1,9 @@
 // hairvox voxelize HAIRFILE -o grid.vdb [--voxel-size V | --voxels-across N] [--diameter D]
 //                  [--density-scale K] [--orientation-tensor] [--threads N] [--memory-budget GIB]
 #include "../commands.h"
-#include <hairvox/core/format.h>
 
 #include <hairvox/core/error.h>
+#include <hairvox/core/format.h>
 #include <hairvox/core/parallel.h>
 #include <hairvox/core/progress.h>
 #include <hairvox/strands/groom_io.h>
@@ -26,8 +26,7 @@ struct VoxelizeOptions {
     std::string output;
     double voxelSize = 0;
     int voxelsAcross = kDefaultVoxelsAcross;
-    float diameter = SplatOptions{}.fiberDiameter;
-    float densityScale = SplatOptions{}.densityScale;
+    FiberScale fiberScale;
     bool tensor = false;
     int threads = 0;
     double memoryBudgetGiB = double(SplatOptions{}.memoryBudgetBytes) / double(1ull << 30);
@@ -55,8 +54,7 @@ void runVoxelize(const VoxelizeOptions& opt) {
     SplatOptions splat;
     splat.voxelSize =
         opt.voxelSize > 0 ? opt.voxelSize : defaultVoxelSize(loaded.groom, opt.voxelsAcross);
-    splat.fiberDiameter = opt.diameter;
-    splat.densityScale = opt.densityScale;
+    splat.fiberScale = opt.fiberScale;
     splat.storeOrientationTensor = opt.tensor;
     splat.memoryBudgetBytes = static_cast<std::uint64_t>(opt.memoryBudgetGiB * double(1ull << 30));
     splat.sourceFile = opt.input;
@@ -104,13 +102,12 @@ void addVoxelizeCommand(CLI::App& app) {
             ->capture_default_str()
             ->check(CLI::Range(1, 1 << 20));
     size->excludes(across);
-    cmd->add_option("--diameter", opt->diameter, "Fiber diameter D, recorded in the grid")
-        ->capture_default_str()
-        ->check(CLI::PositiveNumber);
-    cmd->add_option("--density-scale", opt->densityScale,
-                    "Real hairs per modeled strand, recorded in the grid")
-        ->capture_default_str()
-        ->check(CLI::PositiveNumber);
+    cmd->add_option("--diameter", opt->fiberScale.diameter,
+                    "Fiber diameter D (scene units), recorded in the grid (0, 1000]")
+        ->capture_default_str();
+    cmd->add_option("--density-multiplier", opt->fiberScale.densityMultiplier,
+                    "Real hairs per modeled strand, recorded in the grid [0.01, 10000]")
+        ->capture_default_str();
     cmd->add_flag("--orientation-tensor", opt->tensor,
                   "Also store the second moment E[u u^T] of the fiber directions");
     cmd->add_option("--threads", opt->threads, "Threads (0: all cores)")

@@ -5,7 +5,7 @@
 #include <hairvox/core/math.h>
 #include <hairvox/core/parallel.h>
 #include <hairvox/core/progress.h>
-#include <hairvox/render/render.h>
+#include <hairvox/render/rasterizer.h>
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -25,12 +25,11 @@ using raster::Vec2d;
 using Clock = std::chrono::steady_clock;
 
 constexpr int kTileSize = 32;
-constexpr std::uint32_t kHeadFragment = std::numeric_limits<std::uint32_t>::max();
+constexpr std::uint32_t kSurfaceFragment = std::numeric_limits<std::uint32_t>::max();
 constexpr std::size_t kShadeBatch = 1024;
 constexpr std::size_t kMaxWarnings = 10;
 /// Segments per binning chunk: at least this many, and at most 256 chunks.
 constexpr std::size_t kMinBinChunk = 8192;
-constexpr int kHeadSamples = 8; ///< per side, on the head's silhouette
 
 double secondsSince(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
@@ -42,7 +41,8 @@ double secondsSince(Clock::time_point start) {
 /// directions; a strand's end points take their one segment's), and every
 /// point's projection.
 void prepareVertices(const Groom& groom, const Camera& camera, float radius,
-                     std::vector<Vec3f>& tangents, std::vector<raster::ProjectedVertex>& projected) {
+                     std::vector<Vec3f>& tangents,
+                     std::vector<raster::ProjectedVertex>& projected) {
     tangents.resize(groom.pointCount());
     projected.resize(groom.pointCount());
     tbb::parallel_for(
@@ -53,133 +53,19 @@ void prepareVertices(const Groom& groom, const Camera& camera, float radius,
                 Vec3f previous(0.0f);
                 for (std::size_t k = begin; k < end; ++k) {
                     const Vec3f next =
-                        k + 1 < end ? normalizeOr(groom.points[k + 1] - groom.points[k], Vec3f(0.0f))
-                                    : Vec3f(0.0f);
+                        k + 1 < end
+                            ? normalizeOr(groom.points[k + 1] - groom.points[k], Vec3f(0.0f))
+                            : Vec3f(0.0f);
                     tangents[k] = normalizeOr(previous + next, normalizeOr(next, previous));
                     previous = next;
                 }
                 const std::span<const Vec3f> points(groom.points.data() + begin, end - begin);
-                raster::projectStrand(camera, points, {tangents.data() + begin, end - begin}, radius,
-                                      camera.nearClip(), {projected.data() + begin, end - begin});
+                raster::projectStrand(camera, points, {tangents.data() + begin, end - begin},
+                                      radius, camera.nearClip(),
+                                      {projected.data() + begin, end - begin});
             }
         });
 }
-
-/// The head seen from the camera: which pixels it covers, its depth and its
-/// Lambertian radiance.
-class HeadView {
-public:
-    HeadView(const Head& head, const Camera& camera, const std::vector<Light>& lights)
-        : head_(head), camera_(camera), lights_(lights) {
-        center_ = camera.directionToCamera(head.sphere.center - camera.position());
-        distance_ = glm::length(center_);
-        axis_ = center_ / distance_;
-        // A pixel spans at most 1/f radians, so pixel centres farther than that
-        // from the silhouette cone are wholly inside or outside it.
-        const float psi = safeASin(head.sphere.radius / distance_);
-        const float pixel = 1.0f / camera.focalLength();
-        cosInner_ = std::cos(std::max(psi - pixel, 0.0f));
-        cosOuter_ = std::cos(std::min(psi + pixel, float(Pi)));
-    }
-
-    /// Coverage, mean depth and mean radiance of the head in pixel (x, y).
-    bool cover(int x, int y, float& coverage, float& depth, Rgb& radiance) const {
-        const Vec2f centre(float(x) + 0.5f, float(y) + 0.5f);
-        const float cosPsi = glm::dot(camera_.rayDirection(centre), axis_);
-        if (cosPsi <= cosOuter_)
-            return false;
-        if (cosPsi >= cosInner_) {
-            coverage = 1.0f;
-            return sample(centre, depth, radiance);
-        }
-        int hits = 0;
-        double depthSum = 0;
-        Rgb radianceSum(0.0f);
-        for (int j = 0; j < kHeadSamples; ++j)
-            for (int i = 0; i < kHeadSamples; ++i) {
-                const Vec2f p(float(x) + (float(i) + 0.5f) / kHeadSamples,
-                              float(y) + (float(j) + 0.5f) / kHeadSamples);
-                float z;
-                Rgb l;
-                if (sample(p, z, l)) {
-                    ++hits;
-                    depthSum += double(z);
-                    radianceSum += l;
-                }
-            }
-        if (hits == 0)
-            return false;
-        coverage = float(hits) / float(kHeadSamples * kHeadSamples);
-        depth = static_cast<float>(depthSum / hits);
-        radiance = radianceSum / float(hits);
-        return true;
-    }
-
-private:
-    bool sample(const Vec2f& raster, float& depth, Rgb& radiance) const {
-        const Vec3f dir = camera_.rayDirection(raster);
-        const float b = glm::dot(dir, center_);
-        const float disc = b * b - (distance_ * distance_ - sqr(head_.sphere.radius));
-        const float t = b - std::sqrt(std::max(disc, 0.0f));
-        if (disc < 0 || !(t > 0))
-            return false; // missed, or the head is behind the camera
-        const Vec3f hitCam = t * dir;
-        depth = hitCam.z;
-        const Vec3f x = camera_.position() + camera_.toWorldDirection(hitCam);
-        const Vec3f normal = normalizeOr(x - head_.sphere.center, -camera_.toWorldDirection(dir));
-        Rgb irradiance(0.0f);
-        for (const Light& light : lights_) {
-            const Light::Path path = light.pathFrom(x);
-            const float cosTheta = glm::dot(normal, path.omega);
-            if (cosTheta > 0)
-                irradiance += cosTheta * light.irradiance(path.distance);
-        }
-        radiance = float(InvPi) * head_.albedo * irradiance;
-        return true;
-    }
-
-    const Head& head_;
-    const Camera& camera_;
-    const std::vector<Light>& lights_;
-    Vec3f center_, axis_;
-    float distance_, cosInner_, cosOuter_;
-};
-
-/// Hair wholly behind the head is culled before rasterization. A point is
-/// hidden if the camera ray to it enters a slightly smaller sphere before
-/// reaching it; the shrink keeps the ribbon's width and the head's
-/// anti-aliased silhouette pixels out of the test. The hidden region (sphere
-/// plus its shadow cone from the camera) is convex, so a segment whose two
-/// ends are hidden is hidden.
-class HeadOccluder {
-public:
-    HeadOccluder(const Head& head, const Camera& camera, float fiberRadius) {
-        center_ = camera.directionToCamera(head.sphere.center - camera.position());
-        const float d = glm::length(center_);
-        const float psi = safeASin(head.sphere.radius / d);
-        const float margin = 2.0f / camera.focalLength() +
-                             fiberRadius / std::max(d - head.sphere.radius, camera.nearClip());
-        enabled_ = psi > margin;
-        shrunkRadius_ = d * std::sin(psi - margin);
-        distance2_ = d * d;
-    }
-
-    bool hides(const Vec3f& pc) const {
-        if (!enabled_)
-            return false;
-        const float len = glm::length(pc);
-        if (!(len > 0))
-            return false;
-        const float b = glm::dot(pc, center_) / len;
-        const float disc = b * b - distance2_ + shrunkRadius_ * shrunkRadius_;
-        return disc > 0 && len > b - std::sqrt(disc);
-    }
-
-private:
-    Vec3f center_;
-    float distance2_ = 0, shrunkRadius_ = 0;
-    bool enabled_ = false;
-};
 
 /// Tiles a segment touches, or nothing (culled).
 struct TileRect {
@@ -187,7 +73,7 @@ struct TileRect {
     bool empty() const { return x0 >= x1 || y0 >= y1; }
 };
 
-enum class Cull : std::uint8_t { None, OutsideView, BehindHead };
+enum class Cull : std::uint8_t { None, OutsideView };
 
 /// Whether the segment a → b passes within `r` of the box [lo, hi]: a
 /// conservative test (the box grown by r, slab method).
@@ -216,23 +102,39 @@ bool segmentNearBox(const Vec2d& a, const Vec2d& b, Vec2d lo, Vec2d hi, double r
 /// Everything the tiles share.
 struct RenderContext {
     const Groom& groom;
-    const Scene& scene;
+    const Camera& camera;
     const FragmentShader& shader;
-    const RenderOptions& options;
-    Camera camera;
+    const ShaderLayout& layout;
+    const RasterSettings& settings;
+    const SurfaceLayer& surfaces;
     float fiberRadius;
+    std::size_t stride;         ///< floats per shaded point
+    std::size_t radianceFloats; ///< of those, the radiance layers'
     std::vector<Vec3f> tangents;
     std::vector<raster::ProjectedVertex> projected; ///< per point
     std::vector<std::uint32_t> firstPoint; ///< per segment: the point index of its root-side vertex
     int tilesX = 0, tilesY = 0;
+    /// Per tile: the farthest surface depth if surfaces cover every pixel wholly, else +∞.
+    std::vector<float> tileSurfaceDepth;
     std::vector<std::size_t> binStart; ///< per tile, into binSegments (+1 entry)
     std::vector<std::uint32_t> binSegments;
-    std::optional<HeadView> head;
     Film* film = nullptr;
+    /// Film layer indices: the shader's radiance and average layers, then the rasterizer's own.
+    std::vector<std::size_t> radianceLayer, averageLayer;
+    std::size_t beautyLayer = 0, alphaLayer = 0, surfaceLayer = 0, backgroundLayer = 0,
+                hairAlphaLayer = 0, depthLayer = 0;
 
-    RenderContext(const Groom& g, const Scene& s, const FragmentShader& sh, const RenderOptions& o)
-        : groom(g), scene(s), shader(sh), options(o), camera(s.camera),
-          fiberRadius(0.5f * s.fiberDiameter) {}
+    RenderContext(const Groom& g, const Camera& c, const FragmentShader& sh,
+                  const RasterSettings& st, const SurfaceLayer& su)
+        : groom(g)
+        , camera(c)
+        , shader(sh)
+        , layout(sh.layout())
+        , settings(st)
+        , surfaces(su)
+        , fiberRadius(0.5f * st.fiberScale.diameter)
+        , stride(layout.stride())
+        , radianceFloats(layout.radianceFloats()) {}
 
     std::optional<ScreenRibbon> ribbon(std::uint32_t segment) const {
         const std::uint32_t k = firstPoint[segment];
@@ -247,6 +149,33 @@ struct RenderContext {
     }
 };
 
+/// Per tile, the depth behind which surfaces hide everything: the farthest
+/// surface depth of a tile whose every pixel is wholly covered, else +∞.
+std::vector<float> tileSurfaceDepths(const SurfaceLayer& surfaces, int width, int height,
+                                     int tilesX, int tilesY) {
+    constexpr float inf = std::numeric_limits<float>::infinity();
+    std::vector<float> depth(std::size_t(tilesX) * std::size_t(tilesY), inf);
+    if (surfaces.empty())
+        return depth;
+    for (int ty = 0; ty < tilesY; ++ty)
+        for (int tx = 0; tx < tilesX; ++tx) {
+            float farthest = 0;
+            bool covered = true;
+            for (int y = ty * kTileSize; covered && y < std::min(height, (ty + 1) * kTileSize); ++y)
+                for (int x = tx * kTileSize; x < std::min(width, (tx + 1) * kTileSize); ++x) {
+                    const std::size_t p = std::size_t(y) * std::size_t(width) + std::size_t(x);
+                    if (!(surfaces.coverage[p] >= 1.0f)) {
+                        covered = false;
+                        break;
+                    }
+                    farthest = std::max(farthest, surfaces.depth[p]);
+                }
+            if (covered)
+                depth[std::size_t(ty) * std::size_t(tilesX) + std::size_t(tx)] = farthest;
+        }
+    return depth;
+}
+
 std::vector<std::uint32_t> segmentFirstPoints(const Groom& groom) {
     std::vector<std::uint32_t> first;
     first.reserve(groom.segmentCount());
@@ -259,23 +188,27 @@ std::vector<std::uint32_t> segmentFirstPoints(const Groom& groom) {
 /// Bins segments to the tiles their ribbon may touch. Chunks of segments are
 /// counted, then written, in chunk order: each tile's list is sorted by
 /// segment index whatever the thread count.
-void binSegments(RenderContext& ctx, RenderStats& stats) {
+void binSegments(RenderContext& ctx, RasterStats& stats) {
     const std::size_t segments = ctx.firstPoint.size();
     const std::size_t tiles = std::size_t(ctx.tilesX) * std::size_t(ctx.tilesY);
     const std::size_t chunkSize = std::max(kMinBinChunk, (segments + 255) / 256);
     const std::size_t chunks = (segments + chunkSize - 1) / chunkSize;
     const int width = ctx.camera.width(), height = ctx.camera.height();
-    std::optional<HeadOccluder> occluder;
-    if (ctx.scene.head)
-        occluder.emplace(*ctx.scene.head, ctx.camera, ctx.fiberRadius);
 
     std::vector<TileRect> rects(segments);
     std::vector<Cull> culls(segments, Cull::None);
-    std::vector<std::size_t> counts(chunks * tiles, 0);
+    std::vector<std::size_t> counts(chunks * tiles, 0), culled(chunks, 0);
     auto touches = [&](const ScreenRibbon& r, int tx, int ty) {
         const Vec2d lo(tx * kTileSize, ty * kTileSize);
         return segmentNearBox(r.s0, r.s1, lo, lo + double(kTileSize),
                               std::max(glm::length(r.o0), glm::length(r.o1)));
+    };
+    // Visible in the tile: near it, and not wholly behind the surfaces that cover it.
+    auto visibleIn = [&](const ScreenRibbon& r, int tx, int ty) {
+        const float zMin = 1.0f / std::max(r.invZ0, r.invZ1);
+        return zMin <= ctx.tileSurfaceDepth[std::size_t(ty) * std::size_t(ctx.tilesX) +
+                                            std::size_t(tx)] &&
+               touches(r, tx, ty);
     };
     tbb::parallel_for(std::size_t(0), chunks, [&](std::size_t chunk) {
         throwIfInterrupted();
@@ -289,14 +222,6 @@ void binSegments(RenderContext& ctx, RenderStats& stats) {
                 culls[j] = Cull::OutsideView;
                 continue;
             }
-            if (occluder) {
-                const std::uint32_t k = ctx.firstPoint[j];
-                if (occluder->hides(ctx.camera.toCamera(ctx.groom.points[k])) &&
-                    occluder->hides(ctx.camera.toCamera(ctx.groom.points[k + 1]))) {
-                    culls[j] = Cull::BehindHead;
-                    continue;
-                }
-            }
             TileRect& rect = rects[j];
             rect.x0 = static_cast<std::uint16_t>(std::max(0.0, r->xMin) / kTileSize);
             rect.y0 = static_cast<std::uint16_t>(std::max(0.0, r->yMin) / kTileSize);
@@ -305,9 +230,12 @@ void binSegments(RenderContext& ctx, RenderStats& stats) {
             rect.y1 = static_cast<std::uint16_t>(
                 std::min(double(ctx.tilesY), std::floor(r->yMax / kTileSize) + 1));
             for (int ty = rect.y0; ty < rect.y1; ++ty)
-                for (int tx = rect.x0; tx < rect.x1; ++tx)
-                    if (touches(*r, tx, ty))
+                for (int tx = rect.x0; tx < rect.x1; ++tx) {
+                    if (visibleIn(*r, tx, ty))
                         ++chunkCounts[std::size_t(ty) * std::size_t(ctx.tilesX) + std::size_t(tx)];
+                    else if (touches(*r, tx, ty))
+                        ++culled[chunk];
+                }
         }
     });
 
@@ -334,7 +262,7 @@ void binSegments(RenderContext& ctx, RenderStats& stats) {
             const std::optional<ScreenRibbon> r = ctx.ribbon(static_cast<std::uint32_t>(j));
             for (int ty = rect.y0; ty < rect.y1; ++ty)
                 for (int tx = rect.x0; tx < rect.x1; ++tx)
-                    if (touches(*r, tx, ty))
+                    if (visibleIn(*r, tx, ty))
                         ctx.binSegments[chunkOffsets[std::size_t(ty) * std::size_t(ctx.tilesX) +
                                                      std::size_t(tx)]++] =
                             static_cast<std::uint32_t>(j);
@@ -343,16 +271,15 @@ void binSegments(RenderContext& ctx, RenderStats& stats) {
 
     stats.segments = segments;
     stats.segmentTileRefs = total;
-    for (Cull c : culls) {
+    for (Cull c : culls)
         stats.segmentsOutsideView += c == Cull::OutsideView ? 1u : 0u;
-        stats.segmentsBehindHead += c == Cull::BehindHead ? 1u : 0u;
-    }
+    for (std::size_t c : culled)
+        stats.segmentTilesBehindSurfaces += c;
 }
 
 // --- one tile ----------------------------------------------------------------
 
 constexpr std::uint32_t kNoPoint = std::numeric_limits<std::uint32_t>::max();
-constexpr GlobalTerm kZeroTerm{0.0f, 0.0f, Rgb(0.0f), Rgb(0.0f), Rgb(0.0f)};
 /// Segments rasterized between two compositing steps (see TileRenderer).
 constexpr std::size_t kSegmentsPerStep = 64;
 
@@ -360,7 +287,7 @@ struct Fragment {
     float depth;
     float alpha;         ///< coverage, (0, 1]
     float t;             ///< parameter on the segment, 0 at its root-side vertex
-    std::uint32_t local; ///< index in the tile's segment list, or kHeadFragment
+    std::uint32_t local; ///< index in the tile's segment list, or kSurfaceFragment
     std::uint32_t pixel; ///< index in the tile, row-major
 };
 
@@ -374,13 +301,13 @@ struct Visible {
 
 /// Compositing state of one pixel, carried from one step to the next.
 struct PixelState {
-    float T = 1;             ///< transmittance of everything composited so far
-    float groupT = 1;        ///< T in front of the current strand group
-    float groupCoverage = 0; ///< coverage of the current strand group
+    float T = 1;                        ///< transmittance of everything composited so far
+    float groupT = 1;                   ///< T in front of the current strand group
+    float groupCoverage = 0;            ///< coverage of the current strand group
     std::uint32_t lastPoint = kNoPoint; ///< root-side point of the last composited hair fragment
-    bool closed = false;     ///< opaque: nothing behind is composited
+    bool closed = false;                ///< opaque: nothing behind is composited
     float depthSum = 0, hairWeight = 0;
-    Rgb head{0.0f};
+    Rgb surface{0.0f};
 };
 
 struct TileScratch {
@@ -393,18 +320,15 @@ struct TileScratch {
     std::vector<Fragment> pending, settling, sorted;
     std::vector<std::uint32_t> pixelStart, cursor;
     std::vector<PixelState> pixels;
-    std::vector<Rgb> headRadiance;
     std::vector<Visible> visible;
     std::vector<std::uint32_t> vertexSlot; ///< per local segment: slot of its root-side vertex
     std::vector<std::uint32_t> slotPoint;  ///< per vertex slot: the point index
     std::vector<std::uint32_t> slotStrand; ///< per vertex slot: its strand
-    std::vector<ShadeResult> vertexResults;
-    std::vector<GlobalTerm> vertexTerms, fragmentTerms;
+    std::vector<float> vertexResults;      ///< per vertex slot: stride floats
     std::vector<ShadingPoint> points;
-    std::vector<ShadeResult> results;
-    std::vector<GlobalTerm> terms;
-    std::vector<ShadeResult> pixelSum;  ///< per pixel: weighted radiance
-    std::vector<GlobalTerm> pixelTerms; ///< per pixel × light: weighted sums (σ_f in sigma2_f)
+    std::vector<float> results;  ///< per point of a batch: stride floats
+    std::vector<float> lerped;   ///< one interpolated vertex-rate result
+    std::vector<float> pixelSum; ///< per pixel: stride floats of weighted sums
 };
 
 struct TileResult {
@@ -420,25 +344,14 @@ bool finiteNonNegative(float x) {
     return bits < 0x7f800000u || bits == 0x80000000u;
 }
 
-bool isValid(const ShadeResult& r, std::span<const GlobalTerm> terms) {
+/// Radiance finite and non-negative, averages finite.
+bool isValid(std::span<const float> r, std::size_t radianceFloats) {
     bool ok = true;
-    for (const Rgb* c : {&r.directR, &r.directTT, &r.directTRT, &r.backDirect, &r.scatter})
-        ok = ok && finiteNonNegative(c->r) && finiteNonNegative(c->g) && finiteNonNegative(c->b);
-    for (const GlobalTerm& g : terms)
-        ok = ok && std::isfinite(g.n) && std::isfinite(g.V) && g.P.isFinite() && g.T_s.isFinite() &&
-             g.sigma2_f.isFinite();
+    for (std::size_t i = 0; i < radianceFloats; ++i)
+        ok = ok && finiteNonNegative(r[i]);
+    for (std::size_t i = radianceFloats; i < r.size(); ++i)
+        ok = ok && std::isfinite(r[i]);
     return ok;
-}
-
-ShadeResult lerp(float t, const ShadeResult& a, const ShadeResult& b) {
-    return {hairvox::lerp(t, a.directR, b.directR), hairvox::lerp(t, a.directTT, b.directTT),
-            hairvox::lerp(t, a.directTRT, b.directTRT),
-            hairvox::lerp(t, a.backDirect, b.backDirect), hairvox::lerp(t, a.scatter, b.scatter)};
-}
-
-GlobalTerm lerp(float t, const GlobalTerm& a, const GlobalTerm& b) {
-    return {hairvox::lerp(t, a.n, b.n), hairvox::lerp(t, a.V, b.V), hairvox::lerp(t, a.P, b.P),
-            hairvox::lerp(t, a.T_s, b.T_s), hairvox::lerp(t, a.sigma2_f, b.sigma2_f)};
 }
 
 /// Renders one tile.
@@ -460,7 +373,10 @@ GlobalTerm lerp(float t, const GlobalTerm& a, const GlobalTerm& b) {
 class TileRenderer {
 public:
     TileRenderer(const RenderContext& ctx, TileScratch& s, int tile)
-        : ctx_(ctx), s_(s), film_(*ctx.film), lights_(ctx.scene.lights.size()) {
+        : ctx_(ctx)
+        , s_(s)
+        , film_(*ctx.film)
+        , stride_(ctx.stride) {
         const int tx = tile % ctx.tilesX, ty = tile / ctx.tilesX;
         x0_ = tx * kTileSize;
         y0_ = ty * kTileSize;
@@ -478,7 +394,7 @@ public:
         rasterizeAndComposite();
         finishCoverage();
         const Clock::time_point shadeStart = Clock::now();
-        if (ctx_.scene.shadingRate == ShadingRate::Fragment)
+        if (ctx_.settings.shadingRate == ShadingRate::Fragment)
             shadeFragments();
         else
             shadeVertices();
@@ -499,7 +415,7 @@ private:
     }
 
     /// Projects the tile's segments, orders them by nearest depth, and puts
-    /// the head's fragments in the queue.
+    /// the surfaces' fragments in the queue.
     void prepare() {
         const std::size_t n = bins_.size();
         s_.ribbons.resize(n);
@@ -523,14 +439,14 @@ private:
         openPixels_ = area_;
         s_.pending.clear();
         s_.visible.clear();
-        if (!ctx_.head)
+        if (ctx_.surfaces.empty())
             return;
-        s_.headRadiance.resize(area_);
         for (int y = y0_; y < y1_; ++y)
             for (int x = x0_; x < x1_; ++x) {
-                Fragment f{0, 0, 0, kHeadFragment, pixelIndex(x, y)};
-                if (ctx_.head->cover(x, y, f.alpha, f.depth, s_.headRadiance[f.pixel]))
-                    s_.pending.push_back(f);
+                const std::size_t i = film_.index(x, y);
+                if (ctx_.surfaces.coverage[i] > 0)
+                    s_.pending.push_back({ctx_.surfaces.depth[i], ctx_.surfaces.coverage[i], 0,
+                                          kSurfaceFragment, pixelIndex(x, y)});
             }
     }
 
@@ -618,7 +534,7 @@ private:
     }
 
     void composite(PixelState& st, const Fragment& f) {
-        const bool hair = f.local != kHeadFragment;
+        const bool hair = f.local != kSurfaceFragment;
         if (st.closed) {
             result_.behindOpaque += hair ? 1u : 0u;
             return;
@@ -633,8 +549,8 @@ private:
             st.groupT = st.T;
             st.groupCoverage = f.alpha;
         }
-        const float T = st.groupT * (hair ? hairTransmittance(st.groupCoverage)
-                                          : 1.0f - st.groupCoverage);
+        const float T =
+            st.groupT * (hair ? hairTransmittance(st.groupCoverage) : 1.0f - st.groupCoverage);
         const float w = st.T - T; // this fragment's share: what it took from the transmittance
         st.T = T;
         st.lastPoint = point;
@@ -644,9 +560,9 @@ private:
             st.hairWeight += w;
             ++result_.composited;
         } else {
-            st.head += w * s_.headRadiance[f.pixel];
+            st.surface += w * ctx_.surfaces.radiance[filmIndex(f.pixel)];
         }
-        if (st.T <= ctx_.options.opaqueTransmittance) {
+        if (st.T <= ctx_.settings.opaqueTransmittance) {
             st.closed = true;
             --openPixels_;
         }
@@ -655,19 +571,29 @@ private:
     /// Transmittance through a strand of coverage α standing for k hairs (the
     /// density multiplier) at independent positions in the pixel: (1 − α)^k.
     float hairTransmittance(float alpha) const {
-        const float k = ctx_.scene.densityMultiplier;
+        const float k = ctx_.settings.fiberScale.densityMultiplier;
         return k == 1.0f ? 1.0f - alpha : std::exp(k * std::log1p(-alpha));
     }
 
     void finishCoverage() {
+        float* alpha = film_.layer(ctx_.alphaLayer).data.data();
+        float* hairAlpha = film_.layer(ctx_.hairAlphaLayer).data.data();
+        float* depth = film_.layer(ctx_.depthLayer).data.data();
+        float* surface = film_.layer(ctx_.surfaceLayer).data.data();
+        float* background = film_.layer(ctx_.backgroundLayer).data.data();
+        float* beauty = film_.layer(ctx_.beautyLayer).data.data();
         for (std::uint32_t p = 0; p < area_; ++p) {
             const PixelState& st = s_.pixels[p];
             const std::size_t i = filmIndex(p);
-            film_.alpha[i] = 1.0f - st.T;
-            film_.hairAlpha[i] = st.hairWeight;
-            film_.depth[i] = st.T < 1.0f ? st.depthSum / (1.0f - st.T) : 0.0f;
-            film_.head[i] = st.head;
-            film_.background[i] = st.T * ctx_.scene.background;
+            alpha[i] = 1.0f - st.T;
+            hairAlpha[i] = st.hairWeight;
+            depth[i] = st.T < 1.0f ? st.depthSum / (1.0f - st.T) : 0.0f;
+            const Rgb b = st.T * ctx_.settings.background;
+            for (int c = 0; c < 3; ++c) {
+                surface[3 * i + std::size_t(c)] = st.surface[c];
+                background[3 * i + std::size_t(c)] = b[c];
+                beauty[3 * i + std::size_t(c)] = st.surface[c] + b[c];
+            }
         }
     }
 
@@ -697,42 +623,37 @@ private:
         return sp;
     }
 
-    /// Shades `count` points from s_.points; rejects invalid results (zeroing
-    /// them) and reports them with `where(i)`.
+    /// Shades `count` points from s_.points into s_.results; rejects invalid
+    /// results (zeroing them) and reports them with `where(i)`.
     template <typename Where>
     void shadeBatch(std::size_t count, Where&& where) {
         throwIfInterrupted(); // an expensive shader (exact mode) makes a tile long
-        s_.results.resize(count);
-        s_.terms.resize(count * lights_);
-        ctx_.shader.shade(std::span(s_.points.data(), count), std::span(s_.results.data(), count),
-                          std::span(s_.terms.data(), count * lights_));
+        s_.results.resize(count * stride_);
+        ctx_.shader.shade(std::span(s_.points.data(), count),
+                          std::span(s_.results.data(), count * stride_));
         result_.shadingPoints += count;
         for (std::size_t i = 0; i < count; ++i) {
-            const std::span<GlobalTerm> terms(s_.terms.data() + i * lights_, lights_);
-            if (isValid(s_.results[i], terms))
+            const std::span<float> r(s_.results.data() + i * stride_, stride_);
+            if (isValid(r, ctx_.radianceFloats))
                 continue;
             ++result_.invalid;
-            if (result_.warnings.size() < kMaxWarnings)
-                result_.warnings.push_back(
-                    strCat("shader returned a non-finite or negative value ", where(i), " for ",
-                           s_.points[i], ": ", s_.results[i], "; set to black"));
-            s_.results[i] = ShadeResult{};
-            std::fill(terms.begin(), terms.end(), kZeroTerm);
+            if (result_.warnings.size() < kMaxWarnings) {
+                std::string values;
+                for (float x : r)
+                    values += strCat(values.empty() ? "" : " ", x);
+                result_.warnings.push_back(strCat("shader returned a non-finite or negative value ",
+                                                  where(i), " for ", s_.points[i], ": [", values,
+                                                  "]; set to black"));
+            }
+            std::fill(r.begin(), r.end(), 0.0f);
         }
     }
 
     /// Adds a shaded fragment to its pixel's sums.
-    void accumulate(const Visible& v, const ShadeResult& r, std::span<const GlobalTerm> terms) {
-        addWeighted(s_.pixelSum[v.pixel], r, v.weight);
-        GlobalTerm* sums = s_.pixelTerms.data() + std::size_t(v.pixel) * lights_;
-        for (std::size_t l = 0; l < lights_; ++l) {
-            GlobalTerm& a = sums[l];
-            const GlobalTerm& g = terms[l];
-            a.V += v.weight * g.V;
-            a.n += v.weight * g.n;
-            a.T_s += v.weight * g.T_s;
-            a.sigma2_f += v.weight * safeSqrt(g.sigma2_f); // σ_f, averaged
-        }
+    void accumulate(const Visible& v, const float* r) {
+        float* sum = s_.pixelSum.data() + std::size_t(v.pixel) * stride_;
+        for (std::size_t k = 0; k < stride_; ++k)
+            sum[k] += v.weight * r[k];
     }
 
     std::string pixelName(std::uint32_t pixel) const {
@@ -741,8 +662,7 @@ private:
     }
 
     void shadeFragments() {
-        s_.pixelSum.assign(area_, ShadeResult{});
-        s_.pixelTerms.assign(area_ * lights_, kZeroTerm);
+        s_.pixelSum.assign(std::size_t(area_) * stride_, 0.0f);
         for (std::size_t begin = 0; begin < s_.visible.size(); begin += kShadeBatch) {
             const std::size_t count = std::min(kShadeBatch, s_.visible.size() - begin);
             s_.points.resize(count);
@@ -753,14 +673,12 @@ private:
             shadeBatch(count,
                        [&](std::size_t i) { return pixelName(s_.visible[begin + i].pixel); });
             for (std::size_t i = 0; i < count; ++i)
-                accumulate(s_.visible[begin + i], s_.results[i],
-                           std::span(s_.terms.data() + i * lights_, lights_));
+                accumulate(s_.visible[begin + i], s_.results.data() + i * stride_);
         }
     }
 
     void shadeVertices() {
-        s_.pixelSum.assign(area_, ShadeResult{});
-        s_.pixelTerms.assign(area_ * lights_, kZeroTerm);
+        s_.pixelSum.assign(std::size_t(area_) * stride_, 0.0f);
         // Vertex slots of the segments with a visible fragment, in segment
         // order; a segment's tip-side vertex is always the slot after its
         // root-side one, which the next segment of the strand reuses.
@@ -783,53 +701,51 @@ private:
             s_.slotStrand.push_back(s_.strandOf[i]);
         }
         const std::size_t slots = s_.slotPoint.size();
-        s_.vertexResults.resize(slots);
-        s_.vertexTerms.resize(slots * lights_);
+        s_.vertexResults.resize(slots * stride_);
         for (std::size_t begin = 0; begin < slots; begin += kShadeBatch) {
             const std::size_t count = std::min(kShadeBatch, slots - begin);
             s_.points.resize(count);
             for (std::size_t i = 0; i < count; ++i)
                 s_.points[i] = pointAtVertex(s_.slotPoint[begin + i], s_.slotStrand[begin + i]);
             shadeBatch(count, [&](std::size_t) { return std::string("at a strand vertex"); });
-            std::copy_n(s_.results.begin(), count,
-                        s_.vertexResults.begin() + std::ptrdiff_t(begin));
-            std::copy_n(s_.terms.begin(), count * lights_,
-                        s_.vertexTerms.begin() + std::ptrdiff_t(begin * lights_));
+            std::copy_n(s_.results.begin(), count * stride_,
+                        s_.vertexResults.begin() + std::ptrdiff_t(begin * stride_));
         }
-        std::vector<GlobalTerm>& terms = s_.fragmentTerms;
-        terms.resize(lights_);
+        s_.lerped.resize(stride_);
         for (const Visible& v : s_.visible) {
-            const std::uint32_t slot = s_.vertexSlot[v.local];
-            const ShadeResult r = lerp(v.t, s_.vertexResults[slot], s_.vertexResults[slot + 1]);
-            for (std::size_t l = 0; l < lights_; ++l)
-                terms[l] = lerp(v.t, s_.vertexTerms[slot * lights_ + l],
-                                s_.vertexTerms[(slot + 1) * lights_ + l]);
-            accumulate(v, r, terms);
+            const float* a =
+                s_.vertexResults.data() + std::size_t(s_.vertexSlot[v.local]) * stride_;
+            const float* b = a + stride_;
+            for (std::size_t k = 0; k < stride_; ++k)
+                s_.lerped[k] = hairvox::lerp(v.t, a[k], b[k]);
+            accumulate(v, s_.lerped.data());
         }
     }
 
-    /// Radiance layers get the premultiplied sums; per-light AOVs the sums
-    /// divided by the hair's weight (averages).
+    /// Radiance layers get the premultiplied sums (and add to the beauty);
+    /// average layers the sums divided by the hair's weight.
     void finishShading() {
-        const std::size_t pixels = film_.pixelCount();
+        float* beauty = film_.layer(ctx_.beautyLayer).data.data();
         for (std::uint32_t p = 0; p < area_; ++p) {
             const float w = s_.pixels[p].hairWeight;
             if (!(w > 0))
                 continue;
             const std::size_t i = filmIndex(p);
-            const ShadeResult& r = s_.pixelSum[p];
-            film_.directR[i] = r.directR;
-            film_.directTT[i] = r.directTT;
-            film_.directTRT[i] = r.directTRT;
-            film_.backDirect[i] = r.backDirect;
-            film_.scatter[i] = r.scatter;
-            for (std::size_t l = 0; l < lights_; ++l) {
-                const GlobalTerm& a = s_.pixelTerms[std::size_t(p) * lights_ + l];
-                const std::size_t j = l * pixels + i;
-                film_.V[j] = a.V / w;
-                film_.n[j] = a.n / w;
-                film_.T_s[j] = a.T_s / w;
-                film_.sigma_f[j] = a.sigma2_f / w;
+            const float* sum = s_.pixelSum.data() + std::size_t(p) * stride_;
+            for (std::size_t l = 0; l < ctx_.radianceLayer.size(); ++l) {
+                float* layer = film_.layer(ctx_.radianceLayer[l]).data.data() + 3 * i;
+                for (std::size_t c = 0; c < 3; ++c) {
+                    layer[c] = sum[3 * l + c];
+                    beauty[3 * i + c] += sum[3 * l + c];
+                }
+            }
+            const float invW = 1.0f / w;
+            std::size_t k = ctx_.radianceFloats;
+            for (std::size_t l = 0; l < ctx_.averageLayer.size(); ++l) {
+                FilmLayer& layer = film_.layer(ctx_.averageLayer[l]);
+                const auto channels = static_cast<std::size_t>(layer.channels);
+                for (std::size_t c = 0; c < channels; ++c)
+                    layer.data[channels * i + c] = sum[k++] * invW;
             }
         }
     }
@@ -837,7 +753,7 @@ private:
     const RenderContext& ctx_;
     TileScratch& s_;
     Film& film_;
-    std::size_t lights_;
+    std::size_t stride_;
     int x0_, y0_, x1_, y1_, width_;
     std::uint32_t area_;
     std::span<const std::uint32_t> bins_;
@@ -847,49 +763,67 @@ private:
 
 } // namespace
 
-std::ostream& operator<<(std::ostream& os, const RenderStats& s) {
-    return os << "RenderStats(" << s.seconds << " s: setup " << s.setupSeconds << " s, raster "
+std::ostream& operator<<(std::ostream& os, const RasterStats& s) {
+    return os << "RasterStats(" << s.seconds << " s: setup " << s.setupSeconds << " s, raster "
               << s.rasterSeconds << " s, shade " << s.shadeSeconds << " s; " << s.segments
               << " segments, " << s.segmentsOutsideView << " outside the view, "
-              << s.segmentsBehindHead << " behind the head, " << s.segmentTileRefs
-              << " segment-tile pairs; " << s.fragments << " fragments, "
-              << s.fragmentsComposited << " composited, " << s.fragmentsBehindOpaque
-              << " behind opaque pixels; " << s.shadingPoints << " shading points, "
-              << s.invalidSamples << " rejected; " << s.tiles << " tiles)";
+              << s.segmentTileRefs << " segment-tile pairs, " << s.segmentTilesBehindSurfaces
+              << " behind surfaces; " << s.fragments << " fragments, " << s.fragmentsComposited
+              << " composited, " << s.fragmentsBehindOpaque << " behind opaque pixels; "
+              << s.shadingPoints << " shading points, " << s.invalidSamples << " rejected; "
+              << s.tiles << " tiles)";
 }
 
-RenderOutput renderImage(const Groom& groom, const Scene& scene, const FragmentShader& shader,
-                         const RenderOptions& options) {
+RasterOutput rasterize(const Groom& groom, const Camera& camera, const FragmentShader& shader,
+                       const RasterSettings& settings, const SurfaceLayer& surfaces) {
     const Clock::time_point start = Clock::now();
-    scene.validate();
-    if (!(options.opaqueTransmittance >= 0.0f && options.opaqueTransmittance < 1.0f))
-        throw InputError(strCat("opaque transmittance ", options.opaqueTransmittance,
+    settings.fiberScale.validate();
+    if (!(settings.opaqueTransmittance >= 0.0f && settings.opaqueTransmittance < 1.0f))
+        throw InputError(strCat("opaque transmittance ", settings.opaqueTransmittance,
                                 ": expected a number in [0, 1)"));
+    if (!settings.background.isFinite() || settings.background.minComponent() < 0)
+        throw InputError(
+            strCat("background ", settings.background, ": expected finite values >= 0"));
     if (groom.pointCount() >= std::numeric_limits<std::uint32_t>::max())
-        throw InputError(strCat("groom: ", groom.pointCount(), " points: expected fewer than 2^32"));
-    const ThreadLimit threadLimit(options.threads);
+        throw InputError(
+            strCat("groom: ", groom.pointCount(), " points: expected fewer than 2^32"));
+    const std::size_t pixels = std::size_t(camera.width()) * std::size_t(camera.height());
+    if (!surfaces.empty() &&
+        (surfaces.coverage.size() != pixels || surfaces.depth.size() != pixels ||
+         surfaces.radiance.size() != pixels))
+        throw InputError(strCat("surface layer of ", surfaces.coverage.size(), " pixels for a ",
+                                camera.width(), " x ", camera.height(), " camera"));
+    const ThreadLimit threadLimit(settings.threads);
 
-    RenderContext ctx(groom, scene, shader, options);
-    std::vector<std::string> lightNames;
-    for (const Light& light : scene.lights)
-        lightNames.push_back(light.name);
-    RenderOutput out;
-    out.film = Film(ctx.camera.width(), ctx.camera.height(), std::move(lightNames));
-    ctx.film = &out.film;
-    if (scene.head)
-        ctx.head.emplace(*scene.head, ctx.camera, scene.lights);
+    RenderContext ctx(groom, camera, shader, settings, surfaces);
+    RasterOutput out;
+    out.film = Film(camera.width(), camera.height());
+    Film& film = out.film;
+    ctx.beautyLayer = film.addLayer(std::string(Film::kBeauty), 3);
+    ctx.alphaLayer = film.addLayer(std::string(Film::kAlpha), 1);
+    for (const std::string& name : ctx.layout.radiance)
+        ctx.radianceLayer.push_back(film.addLayer(name, 3));
+    ctx.surfaceLayer = film.addLayer(kSurfaceLayer, 3);
+    ctx.backgroundLayer = film.addLayer(kBackgroundLayer, 3);
+    ctx.hairAlphaLayer = film.addLayer(kHairAlphaLayer, 1);
+    ctx.depthLayer = film.addLayer(kDepthLayer, 1, /*fullPrecision=*/true);
+    for (const ShaderLayout::AverageLayer& a : ctx.layout.averages)
+        ctx.averageLayer.push_back(film.addLayer(a.name, a.channels));
+    ctx.film = &film;
 
     prepareVertices(groom, ctx.camera, ctx.fiberRadius, ctx.tangents, ctx.projected);
     ctx.firstPoint = segmentFirstPoints(groom);
     ctx.tilesX = (ctx.camera.width() + kTileSize - 1) / kTileSize;
     ctx.tilesY = (ctx.camera.height() + kTileSize - 1) / kTileSize;
+    ctx.tileSurfaceDepth =
+        tileSurfaceDepths(surfaces, camera.width(), camera.height(), ctx.tilesX, ctx.tilesY);
     binSegments(ctx, out.stats);
     out.stats.setupSeconds = secondsSince(start);
 
     const int tiles = ctx.tilesX * ctx.tilesY;
     std::vector<TileResult> results(static_cast<std::size_t>(tiles));
     tbb::enumerable_thread_specific<TileScratch> scratch;
-    ProgressReporter progress("render", static_cast<std::uint64_t>(tiles), options.progress);
+    ProgressReporter progress("render", static_cast<std::uint64_t>(tiles), settings.progress);
     const Clock::time_point tilesStart = Clock::now();
     tbb::parallel_for(
         tbb::blocked_range<int>(0, tiles, 1), [&](const tbb::blocked_range<int>& range) {
@@ -902,7 +836,7 @@ RenderOutput renderImage(const Groom& groom, const Scene& scene, const FragmentS
     progress.finish();
     const double tilesSeconds = secondsSince(tilesStart);
 
-    RenderStats& st = out.stats;
+    RasterStats& st = out.stats;
     double rasterThread = 0, shadeThread = 0;
     for (TileResult& r : results) {
         rasterThread += r.rasterSeconds;
@@ -918,8 +852,8 @@ RenderOutput renderImage(const Groom& groom, const Scene& scene, const FragmentS
                 out.warnings.push_back(std::move(w));
     }
     if (st.invalidSamples > out.warnings.size())
-        out.warnings.push_back(strCat(st.invalidSamples - out.warnings.size(),
-                                      " more shader results were rejected"));
+        out.warnings.push_back(
+            strCat(st.invalidSamples - out.warnings.size(), " more shader results were rejected"));
     const double threadTotal = rasterThread + shadeThread;
     st.rasterSeconds = threadTotal > 0 ? tilesSeconds * rasterThread / threadTotal : 0;
     st.shadeSeconds = tilesSeconds - st.rasterSeconds;

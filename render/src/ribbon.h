@@ -20,7 +20,7 @@
 #pragma once
 
 #include <hairvox/core/vecmath.h>
-#include <hairvox/render/camera.h>
+#include <hairvox/geometry/camera.h>
 
 #include <glm/vec2.hpp>
 
@@ -35,17 +35,17 @@ namespace hairvox::raster {
 using Vec2d = glm::dvec2;
 
 struct ScreenRibbon {
-    Vec2d s0, s1;        ///< raster positions of the (clipped) ends
-    Vec2d o0, o1;        ///< half-width offsets at the ends
-    float invZ0, invZ1;  ///< 1 / depth at the ends
-    float t0, t1;        ///< the ends' parameters on the original segment
+    Vec2d s0, s1;                  ///< raster positions of the (clipped) ends
+    Vec2d o0, o1;                  ///< half-width offsets at the ends
+    float invZ0, invZ1;            ///< 1 / depth at the ends
+    float t0, t1;                  ///< the ends' parameters on the original segment
     double xMin, yMin, xMax, yMax; ///< raster bounds of the quad
 
     /// Finite bounds and depths (a groom with absurd coordinates can overflow).
     bool finite() const {
         return std::isfinite(xMin) && std::isfinite(xMax) && std::isfinite(yMin) &&
-               std::isfinite(yMax) && std::isfinite(invZ0) && std::isfinite(invZ1) &&
-               invZ0 > 0 && invZ1 > 0;
+               std::isfinite(yMax) && std::isfinite(invZ0) && std::isfinite(invZ1) && invZ0 > 0 &&
+               invZ1 > 0;
     }
 
     /// Where the pixel centre `c` falls along the ribbon: the parameter on the
@@ -110,8 +110,8 @@ void clip(const Polygon& in, double c, Polygon& out) {
         if (aIn != bIn) {
             Vec2d p;
             p[Axis] = c; // exactly on the line
-            p[1 - Axis] = a[1 - Axis] + (c - a[Axis]) / (b[Axis] - a[Axis]) *
-                                            (b[1 - Axis] - a[1 - Axis]);
+            p[1 - Axis] =
+                a[1 - Axis] + (c - a[Axis]) / (b[Axis] - a[Axis]) * (b[1 - Axis] - a[1 - Axis]);
             out.v[out.n++] = p;
         }
     }
@@ -224,7 +224,8 @@ template <typename Emit, typename Wanted>
 void rasterizeRibbon(const ScreenRibbon& r, int x0, int y0, int x1, int y1, Emit&& emit,
                      Wanted&& wanted) {
     const Vec2d q[4] = {r.s0 + r.o0, r.s1 + r.o1, r.s1 - r.o1, r.s0 - r.o0};
-    const bool inside = r.xMin >= x0 - 1 && r.xMax <= x1 + 1 && r.yMin >= y0 - 1 && r.yMax <= y1 + 1;
+    const bool inside =
+        r.xMin >= x0 - 1 && r.xMax <= x1 + 1 && r.yMin >= y0 - 1 && r.yMax <= y1 + 1;
     auto cover = [&](const Polygon& p) {
         if (inside)
             rasterizeConvex(p, x0, y0, x1, y1, emit, wanted);

@@ -1,6 +1,7 @@
 #include <hairvox/core/error.h>
 #include <hairvox/core/math.h>
 #include <hairvox/shading/dual_scattering_shader.h>
+#include <hairvox/shading/longitudinal.h>
 
 #include <algorithm>
 #include <cmath>
@@ -20,27 +21,18 @@ DualScatteringTables tablesFor(const DualScatteringTables& tables, float d_b) {
     return tables.options().d_b == d_b ? tables : tables.withBackwardDensity(d_b);
 }
 
-/// ½·g(x; sqrt(σ²)) per channel: unit area over θ_o for x = θ_h − shift.
-Rgb halfGaussian(const Rgb& x, const Rgb& sigma2) {
-    Rgb r;
-    for (int c = 0; c < 3; ++c) {
-        const float invSigma2 = 1.0f / sigma2[c];
-        r[c] = std::sqrt(invSigma2 * static_cast<float>(1.0 / (8.0 * Pi))) *
-               std::exp(-0.5f * x[c] * x[c] * invSigma2);
-    }
-    return r;
-}
-
 } // namespace
 
 DualScatteringShader::DualScatteringShader(const MarschnerBcsdf& bcsdf,
                                            const DualScatteringTables& tables,
                                            const DualScatteringParams& params)
-    : bcsdf_(bcsdf), tables_(tablesFor(tables, params.d_b)), params_(params) {
+    : bcsdf_(bcsdf)
+    , tables_(tablesFor(tables, params.d_b))
+    , params_(params) {
     params_.validate();
     if (paramsDigest(bcsdf.params()) != paramsDigest(tables.params()))
-        throw std::invalid_argument(strCat("DualScatteringShader: tables built for ", tables.params(),
-                                           " used with ", bcsdf.params()));
+        throw std::invalid_argument(strCat("DualScatteringShader: tables built for ",
+                                           tables.params(), " used with ", bcsdf.params()));
 }
 
 DualScatteringShader::Backscatter DualScatteringShader::backscatter(float theta_i) const {
@@ -55,7 +47,8 @@ Rgb DualScatteringShader::fBack(const FiberAngles& a, const Backscatter& b,
     const float azimuthal = 0.5f * std::max(a.cosPhi, 0.0f);
     if (azimuthal == 0)
         return Rgb(0.0f);
-    const Rgb longitudinal = halfGaussian(Rgb(a.theta_h) - b.DeltaBar_b, b.sigma2Bar_b + sigma2);
+    const Rgb longitudinal =
+        longitudinalLobe(Rgb(a.theta_h) - b.DeltaBar_b, b.sigma2Bar_b + sigma2);
     return b.ABar_b * longitudinal * (azimuthal / a.cos2Theta_d);
 }
 
@@ -68,7 +61,8 @@ Rgb DualScatteringShader::fsScatter(const FiberAngles& a, const Rgb& sigma2_f) c
     Rgb sum(0.0f);
     for (Lobe p : kLobes) {
         const float beta = bcsdf_.beta(p);
-        sum += ng[p] * halfGaussian(Rgb(a.theta_h - bcsdf_.alpha(p)), Rgb(beta * beta) + sigma2_f);
+        sum +=
+            ng[p] * longitudinalLobe(Rgb(a.theta_h - bcsdf_.alpha(p)), Rgb(beta * beta) + sigma2_f);
     }
     return sum * (1.0f / a.cos2Theta_d);
 }
@@ -91,7 +85,8 @@ ShadeResult DualScatteringShader::shade(const FiberAngles& a, const GlobalTerm& 
     if (scatter) {
         const Rgb sigma2_f = max(g.sigma2_f, Rgb(0.0f));
         r.scatter = g.T_s *
-                    (fsScatter(a, sigma2_f) + static_cast<float>(Pi) * params_.d_b * fBack(a, b, sigma2_f)) *
+                    (fsScatter(a, sigma2_f) +
+                     static_cast<float>(Pi) * params_.d_b * fBack(a, b, sigma2_f)) *
                     a.cosTheta_i;
     }
     return r;

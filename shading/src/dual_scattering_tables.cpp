@@ -6,6 +6,7 @@
 #include <hairvox/core/math.h>
 #include <hairvox/shading/azimuthal.h>
 #include <hairvox/shading/dual_scattering_tables.h>
+#include <hairvox/shading/longitudinal.h>
 
 #include <tbb/parallel_for.h>
 
@@ -81,7 +82,9 @@ struct Halves {
 /// ∫_{−π/2}^{π/2} g(wrap(φ − μ); w) dφ: the part of a wrapped-difference
 /// Gaussian lobe at μ that falls in the back half.
 double backMassOfLobe(double mu, double w) {
-    const auto cdf = [w](double x) { return 0.5 * std::erfc(-x / (w * std::sqrt(2.0))); };
+    const auto cdf = [w](double x) {
+        return 0.5 * std::erfc(-x / (w * std::sqrt(2.0)));
+    };
     double mass = 0;
     for (int k = -1; k <= 1; ++k) {
         const double lo = std::max(-PiOver2 - mu + TwoPi * k, -Pi);
@@ -159,10 +162,12 @@ Halves integrateAzimuth(int p, const FiberParams& params, double theta_d, const 
 double sigma2Bar_b(double aF, double aB, double beta2F, double beta2B, double d_b) {
     aF = std::min(aF, kMaxForwardAttenuation);
     const double aB3 = aB * aB * aB;
-    const double num = aB * std::sqrt(2 * beta2F + beta2B) + aB3 * std::sqrt(2 * beta2F + 3 * beta2B);
+    const double num =
+        aB * std::sqrt(2 * beta2F + beta2B) + aB3 * std::sqrt(2 * beta2F + 3 * beta2B);
     const double den = aB + aB3 * (2 * std::sqrt(beta2F) + 3 * std::sqrt(beta2B));
     // ā_b → 0: the ratio tends to sqrt(2β̄_f² + β̄_b²).
-    const double sigma = (1 + d_b * aF * aF) * (den > 0 ? num / den : std::sqrt(2 * beta2F + beta2B));
+    const double sigma =
+        (1 + d_b * aF * aF) * (den > 0 ? num / den : std::sqrt(2 * beta2F + beta2B));
     return sigma * sigma;
 }
 
@@ -184,7 +189,7 @@ Sample buildRow(const FiberParams& params, const TableBuildOptions& options, dou
             lobe[p] += gl.integrate<Halves>(cuts[k], cuts[k + 1], [&](double theta_o) {
                 const double theta_h = 0.5 * (theta + theta_o), theta_d = 0.5 * (theta_o - theta);
                 const double cosO = std::cos(theta_o), cosD = std::cos(theta_d);
-                const double m = 0.5 * gaussian(theta_h - alpha[p], beta[p]);
+                const double m = longitudinalLobe(theta_h - alpha[p], beta[p] * beta[p]);
                 return (m * cosO * cosO / (cosD * cosD)) *
                        integrateAzimuth(static_cast<int>(p), params, theta_d, gl, eccentricGl);
             });
@@ -214,14 +219,16 @@ Sample buildRow(const FiberParams& params, const TableBuildOptions& options, dou
 
         const double aFc = std::min(aF, kMaxForwardAttenuation);
         const double aF2 = aFc * aFc, oneMinus = 1 - aF2;
-        const double ABar = std::min(aB * aF2 / oneMinus + aB * aB * aB * aF2 / (oneMinus * oneMinus), 1.0);
+        const double ABar =
+            std::min(aB * aF2 / oneMinus + aB * aB * aB * aF2 / (oneMinus * oneMinus), 1.0);
         // Eq. 11's (1 − ā_f²)⁻³ still reaches ~1e3 at the cap: for light hair
         // with extreme α_R the "shift" exceeds the sphere. Beyond ±π/2 it
         // would only move the lobe off the domain of θ_h.
-        const double DeltaBar = std::clamp(
-            alphaB * (1 - 2 * aB * aB / (oneMinus * oneMinus)) +
-                alphaF * (2 * oneMinus * oneMinus + 4 * aF2 * aB * aB) / (oneMinus * oneMinus * oneMinus),
-            -PiOver2, PiOver2);
+        const double DeltaBar =
+            std::clamp(alphaB * (1 - 2 * aB * aB / (oneMinus * oneMinus)) +
+                           alphaF * (2 * oneMinus * oneMinus + 4 * aF2 * aB * aB) /
+                               (oneMinus * oneMinus * oneMinus),
+                       -PiOver2, PiOver2);
 
         s.aBar_f[c] = static_cast<float>(aF);
         s.aBar_b[c] = static_cast<float>(aB);
@@ -300,12 +307,14 @@ DualScatteringTables DualScatteringTables::build(const FiberParams& params,
     const auto buildRows = [&](std::size_t begin, std::size_t end) {
         for (std::size_t k = begin; k < end; ++k) {
             throwIfInterrupted();
-            t.rows_[k] = buildRow(params, options, double(t.theta(static_cast<int>(k))), gl, eccentricGl);
+            t.rows_[k] =
+                buildRow(params, options, double(t.theta(static_cast<int>(k))), gl, eccentricGl);
         }
     };
     if (options.threaded)
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1),
-                          [&](const tbb::blocked_range<std::size_t>& r) { buildRows(r.begin(), r.end()); });
+        tbb::parallel_for(
+            tbb::blocked_range<std::size_t>(0, n, 1),
+            [&](const tbb::blocked_range<std::size_t>& r) { buildRows(r.begin(), r.end()); });
     else
         buildRows(0, n);
     return t;
@@ -335,8 +344,8 @@ DualScatteringTables DualScatteringTables::withBackwardDensity(float d_b) const 
     t.loadedFromCache_ = false;
     for (Sample& s : t.rows_)
         for (int c = 0; c < 3; ++c)
-            s.sigma2Bar_b[c] = static_cast<float>(sigma2Bar_b(
-                s.aBar_f[c], s.aBar_b[c], s.beta2Bar_f[c], s.beta2Bar_b[c], d_b));
+            s.sigma2Bar_b[c] = static_cast<float>(
+                sigma2Bar_b(s.aBar_f[c], s.aBar_b[c], s.beta2Bar_f[c], s.beta2Bar_b[c], d_b));
     return t;
 }
 

@@ -96,8 +96,8 @@ FiberAngles FiberAngles::fromAngles(float theta_i, float theta_o, float phi, flo
 }
 
 std::ostream& operator<<(std::ostream& os, const FiberAngles& a) {
-    return os << "FiberAngles(theta_i=" << degrees(a.theta_i) << "deg, theta_o="
-              << degrees(a.theta_o) << "deg, phi=" << degrees(a.phi)
+    return os << "FiberAngles(theta_i=" << degrees(a.theta_i)
+              << "deg, theta_o=" << degrees(a.theta_o) << "deg, phi=" << degrees(a.phi)
               << "deg, cos2Phi_h=" << a.cos2Phi_h << ")";
 }
 
@@ -132,7 +132,8 @@ struct MarschnerBcsdf::AzimuthalTable {
                 node[2] = static_cast<float>(tt.g);
                 node[3] = static_cast<float>(tt.b);
                 for (std::size_t k = 0; k < nEcc; ++k) {
-                    const double cos2Phi_h = nEcc == 1 ? 1.0 : -1.0 + 2.0 * double(k) / double(nEcc - 1);
+                    const double cos2Phi_h =
+                        nEcc == 1 ? 1.0 : -1.0 + 2.0 * double(k) / double(nEcc - 1);
                     const Rgbd trtValue = azimuthal::N(2, params, theta_d, phi, cos2Phi_h);
                     float* t = &trt[((i * nEcc + k) * nPhi + j) * 3];
                     t[0] = static_cast<float>(trtValue.r);
@@ -152,8 +153,8 @@ struct MarschnerBcsdf::AzimuthalTable {
         };
         int i, j;
         float fx, fy;
-        coordinate(cosTheta_d * static_cast<float>(thetaCount - 1), static_cast<float>(thetaCount - 1), i,
-                   fx);
+        coordinate(cosTheta_d * static_cast<float>(thetaCount - 1),
+                   static_cast<float>(thetaCount - 1), i, fx);
         coordinate(std::abs(phi) * phiScale, static_cast<float>(phiCount - 1), j, fy);
         const float w00 = (1 - fx) * (1 - fy), w01 = (1 - fx) * fy;
         const float w10 = fx * (1 - fy), w11 = fx * fy;
@@ -195,21 +196,18 @@ struct MarschnerBcsdf::AzimuthalTable {
     }
 };
 
-MarschnerBcsdf::MarschnerBcsdf(const FiberParams& params) : params_(params) {
+MarschnerBcsdf::MarschnerBcsdf(const FiberParams& params)
+    : params_(params) {
     params_.validate();
     alpha_ = {params.alpha_R, -0.5f * params.alpha_R, -1.5f * params.alpha_R};
     beta_ = {params.beta_R, 0.5f * params.beta_R, 2.0f * params.beta_R};
-    for (std::size_t p = 0; p < 3; ++p) {
-        invTwoBeta2_[p] = 1.0f / (2.0f * beta_[p] * beta_[p]);
-        mScale_[p] = 0.5f / (beta_[p] * static_cast<float>(Sqrt2Pi));
-    }
+    for (std::size_t p = 0; p < 3; ++p)
+        M_[p] = LongitudinalLobe(alpha_[p], beta_[p] * beta_[p]);
     table_ = std::make_shared<const AzimuthalTable>(params_);
 }
 
 float MarschnerBcsdf::M(Lobe p, float theta_h) const {
-    const auto k = static_cast<std::size_t>(p);
-    const float x = theta_h - alpha_[k];
-    return mScale_[k] * std::exp(-x * x * invTwoBeta2_[k]);
+    return M_[static_cast<std::size_t>(p)](theta_h);
 }
 
 LobeValues MarschnerBcsdf::N(float theta_d, float phi, float cos2Phi_h) const {

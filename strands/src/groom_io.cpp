@@ -1,4 +1,3 @@
-
 #include <hairvox/core/error.h>
 #include <hairvox/strands/groom_io.h>
 
@@ -8,15 +7,6 @@
 #include <fstream>
 
 namespace hairvox {
-
-const char* toString(GroomFormat format) {
-    switch (format) {
-    case GroomFormat::Hair: return "hair";
-    case GroomFormat::Tfx: return "tfx";
-    case GroomFormat::Obj: return "obj";
-    }
-    return "unknown";
-}
 
 LoadedGroom readGroom(const std::filesystem::path& path, const GroomReadOptions& options) {
     std::string ext = path.extension().string();
@@ -37,8 +27,8 @@ LoadedGroom readGroom(const std::filesystem::path& path, const GroomReadOptions&
         return readTfxFile(path, options);
     if (ext == ".obj")
         return readObjFile(path, options);
-    throw InputError(strCat(path.string(),
-                            ": unknown groom format (expected a .hair, .tfx or .obj file)"));
+    throw InputError(
+        strCat(path.string(), ": unknown groom format (expected a .hair, .tfx or .obj file)"));
 }
 
 } // namespace hairvox

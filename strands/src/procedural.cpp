@@ -9,22 +9,6 @@
 
 namespace hairvox {
 
-const char* toString(GroomStyle style) {
-    switch (style) {
-    case GroomStyle::Straight: return "straight";
-    case GroomStyle::Wavy: return "wavy";
-    case GroomStyle::Curly: return "curly";
-    }
-    return "unknown";
-}
-
-std::optional<GroomStyle> parseGroomStyle(std::string_view name) {
-    for (GroomStyle s : {GroomStyle::Straight, GroomStyle::Wavy, GroomStyle::Curly})
-        if (name == toString(s))
-            return s;
-    return std::nullopt;
-}
-
 std::uint32_t ProceduralGroomParams::resolvedPointsPerStrand() const {
     if (pointsPerStrand != 0)
         return pointsPerStrand;
@@ -145,8 +129,8 @@ std::vector<Vec3f> growCentreline(const HeadSphere& head, const Vec3f& rootDir, 
     const float tiltX = normalVariate(rng);
     Vec3f tilt(tiltX, tiltY, tiltZ);
     tilt -= glm::dot(tilt, rootDir) * rootDir;
-    Vec3f dir = normalizeOr(comb + (0.15f + 0.15f * rng.uniformFloat()) * rootDir + 0.2f * tilt,
-                            rootDir);
+    Vec3f dir =
+        normalizeOr(comb + (0.15f + 0.15f * rng.uniformFloat()) * rootDir + 0.2f * tilt, rootDir);
     // Bending rate towards −y, per unit length: stiffer hair falls later.
     const float bend = 2.5f / head.radius;
     line[0] = head.center + head.radius * rootDir;
@@ -203,8 +187,8 @@ void addStyleOffsets(std::vector<Vec3f>& line, const ProceduralGroomParams& para
         } else {
             const float radius = params.curlRadius * look.scale * smoothStep(0.0f, 0.02f, s);
             const float angle = static_cast<float>(TwoPi) * s / params.curlPitch;
-            line[k] = centre[k] + radius * (std::cos(angle + phase) * n +
-                                            std::sin(angle + phase) * b);
+            line[k] =
+                centre[k] + radius * (std::cos(angle + phase) * n + std::sin(angle + phase) * b);
         }
     }
 }
@@ -237,7 +221,8 @@ Groom generateGroom(const ProceduralGroomParams& params) {
         clumpDirs[c] = roots[std::uint64_t(c) * params.strands / clumpCount];
         guides[c] = growCentreline(head, clumpDirs[c], centrelineLength, points, rng);
         looks[c] = {static_cast<float>(TwoPi) * rng.uniformFloat(),
-                    static_cast<float>(TwoPi) * rng.uniformFloat(), 0.85f + 0.3f * rng.uniformFloat()};
+                    static_cast<float>(TwoPi) * rng.uniformFloat(),
+                    0.85f + 0.3f * rng.uniformFloat()};
     }
 
     Groom groom;

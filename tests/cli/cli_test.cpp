@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <sstream>
+
 namespace hairvox {
 namespace {
 
@@ -17,19 +20,46 @@ TEST(Cli, GenerateThenInfo) {
 }
 
 TEST(Cli, InfoOnRatboy) {
-    const auto r = test::runHairvox("info --json '" +
-                                    (test::dataDir() / "Ratboy_mohawk.tfx").string() + "'");
+    const auto r =
+        test::runHairvox("info --json '" + (test::dataDir() / "Ratboy_mohawk.tfx").string() + "'");
     ASSERT_EQ(r.exitCode, 0) << r.output;
     EXPECT_NE(r.output.find("\"strands\": 2228"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("\"points\": 71296"), std::string::npos) << r.output;
 }
 
+/// The subcommands `hairvox --help` lists (the indented words after "Subcommands:").
+std::vector<std::string> listedSubcommands() {
+    const std::string help = test::runHairvox("--help").output;
+    std::vector<std::string> names;
+    std::istringstream in(help.substr(help.find("Subcommands:")));
+    std::string line;
+    std::getline(in, line);
+    while (std::getline(in, line)) {
+        std::istringstream words(line);
+        std::string name;
+        if (line.rfind("  ", 0) == 0 && words >> name)
+            names.push_back(name);
+    }
+    return names;
+}
+
 TEST(Cli, HelpOnEverySubcommand) {
-    for (const char* sub : {"", "generate", "info"}) {
-        const auto r = test::runHairvox(std::string(sub) + " --help");
+    const std::vector<std::string> subcommands = listedSubcommands();
+    // Every command a user can type; a new one is covered by being listed.
+    for (const char* known : {"bench", "compare", "generate", "info", "probe", "render", "tables",
+                              "transmittance", "voxelize"})
+        EXPECT_NE(std::find(subcommands.begin(), subcommands.end(), known), subcommands.end())
+            << known;
+    for (const std::string& sub : subcommands) {
+        const auto r = test::runHairvox(sub + " --help");
         EXPECT_EQ(r.exitCode, 0) << sub << ": " << r.output;
         EXPECT_NE(r.output.find("Usage"), std::string::npos) << sub;
+        EXPECT_NE(r.output.find(sub), std::string::npos) << sub << ": help of another command";
+        EXPECT_NE(r.output.find("--help"), std::string::npos) << sub;
     }
+    const auto top = test::runHairvox("--help");
+    EXPECT_EQ(top.exitCode, 0);
+    EXPECT_NE(top.output.find("Usage"), std::string::npos);
 }
 
 TEST(Cli, BadUsageAndBadInputExitWith2) {

@@ -16,7 +16,9 @@ std::string readText(const std::filesystem::path& p) {
     return ss.str();
 }
 
-std::string quoted(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
+std::string quoted(const std::filesystem::path& p) {
+    return "'" + p.string() + "'";
+}
 
 TEST(CliCommands, RenderDefaultSceneSmall) {
     test::TempDir dir;
@@ -25,7 +27,8 @@ TEST(CliCommands, RenderDefaultSceneSmall) {
     ASSERT_EQ(r.exitCode, 0) << r.output;
     EXPECT_TRUE(std::filesystem::exists(exr));
     EXPECT_TRUE(std::filesystem::exists(dir / "d.png"));
-    for (const char* stage : {"load", "voxelize", "tables", "global term", "raster", "shade", "write"})
+    for (const char* stage :
+         {"load", "voxelize", "tables", "global term", "raster", "shade", "write"})
         EXPECT_NE(r.output.find(stage), std::string::npos) << stage << "\n" << r.output;
     EXPECT_NE(r.output.find("behind opaque"), std::string::npos) << r.output;
 }
@@ -93,15 +96,16 @@ TEST(CliCommands, ProbeRejectsBadInput) {
 TEST(CliCommands, TransmittanceWritesLitGrid) {
     test::TempDir dir;
     const auto vdb = dir / "lit.vdb";
-    const auto r = test::runHairvox("transmittance " + quoted(test::dataDir() / "Ratboy_mohawk.tfx") +
-                                    " --light-pos 0,1.5,0.5 --voxel-size 0.008 -o " + quoted(vdb));
+    const auto r =
+        test::runHairvox("transmittance " + quoted(test::dataDir() / "Ratboy_mohawk.tfx") +
+                         " --light-pos 0,1.5,0.5 --voxel-size 0.008 -o " + quoted(vdb));
     ASSERT_EQ(r.exitCode, 0) << r.output;
     ASSERT_TRUE(std::filesystem::exists(vdb));
     const auto print = test::runShell("vdb_print -l " + quoted(vdb) + " 2>&1");
     if (print.exitCode == 127)
         GTEST_SKIP() << "vdb_print is not installed";
     for (const char* grid : {"Name: n", "Name: V", "Name: T_s", "Name: sigma2_f", "mode: grid",
-                             "light: LightGeometry(point"})
+                             "light: Light(light, point"})
         EXPECT_NE(print.output.find(grid), std::string::npos) << grid << "\n" << print.output;
 }
 
@@ -112,8 +116,9 @@ TEST(CliCommands, TablesFromScene) {
         " --cache-dir " + quoted(dir / "cache") + " -o " + quoted(dir / "t.csv"));
     ASSERT_EQ(r.exitCode, 0) << r.output;
     EXPECT_EQ(readText(dir / "t.csv").rfind("theta,af_r,af_g,af_b,", 0), 0u);
-    EXPECT_EQ(test::runHairvox("tables --scene x.json --eta 1.5 -o " + quoted(dir / "u.csv")).exitCode,
-              2); // --scene excludes fiber options
+    EXPECT_EQ(
+        test::runHairvox("tables --scene x.json --eta 1.5 -o " + quoted(dir / "u.csv")).exitCode,
+        2); // --scene excludes fiber options
 }
 
 } // namespace

@@ -2,7 +2,7 @@
 
 #include <hairvox/core/error.h>
 #include <hairvox/core/interrupt.h>
-#include <hairvox/render/render.h>
+#include <hairvox/render/rasterizer.h>
 #include <hairvox/strands/procedural.h>
 
 #include <gtest/gtest.h>
@@ -15,10 +15,25 @@ namespace hairvox {
 namespace {
 
 using test::addStraightStrand;
-using test::testScene;
+using test::testCamera;
+using test::testSettings;
 
 double sum(const std::vector<float>& v) {
-    return std::accumulate(v.begin(), v.end(), 0.0, [](double a, float b) { return a + double(b); });
+    return std::accumulate(v.begin(), v.end(), 0.0,
+                           [](double a, float b) { return a + double(b); });
+}
+
+const std::vector<float>& alpha(const Film& f) {
+    return f.layer(Film::kAlpha).data;
+}
+const std::vector<float>& hairAlpha(const Film& f) {
+    return f.layer(kHairAlphaLayer).data;
+}
+const std::vector<float>& depth(const Film& f) {
+    return f.layer(kDepthLayer).data;
+}
+Rgb rgb(const Film& f, std::string_view layer, std::size_t p) {
+    return f.layer(layer).rgb(p);
 }
 
 /// Focal length in pixels of a testScene camera of the given height and fov.
@@ -30,8 +45,8 @@ double focalPixels(int height, double fovDegrees) {
 // so a fiber there is an exact rectangle of D·f × L·f pixels.
 TEST(RasterCoverage, ThinFiberCoversWidthTimesLength) {
     const int size = 256;
-    Scene scene = testScene(size, size, Vec3f(0, 0, 1), Vec3f(0, 0, 0));
-    scene.fiberDiameter = 5e-4f; // 0.24 pixel
+    const Camera camera = testCamera(size, size, Vec3f(0, 0, 1), Vec3f(0, 0, 0));
+    const RasterSettings settings = testSettings(5e-4f); // 0.24 pixel
     const double f = focalPixels(size, 30.0);
     for (int segments : {1, 7}) {
         SCOPED_TRACE(segments);
@@ -39,51 +54,52 @@ TEST(RasterCoverage, ThinFiberCoversWidthTimesLength) {
         const Vec3f a(-0.1013f, -0.0571f, 0.0f), b(0.0877f, 0.0719f, 0.0f);
         addStraightStrand(groom, a, b, segments);
         const test::ConstantShader shader;
-        const RenderOutput out = renderImage(groom, scene, shader);
-        const double expected = double(scene.fiberDiameter) * f * double(glm::distance(a, b)) * f;
+        const RasterOutput out = rasterize(groom, camera, shader, settings);
+        const double expected =
+            double(settings.fiberScale.diameter) * f * double(glm::distance(a, b)) * f;
         // Adjacent segments add their coverage: the strand counts once.
         // Measured: 4e-8 relative.
-        EXPECT_NEAR(sum(out.film.alpha), expected, 1e-6 * expected);
-        EXPECT_NEAR(sum(out.film.hairAlpha), expected, 1e-6 * expected);
+        EXPECT_NEAR(sum(alpha(out.film)), expected, 1e-6 * expected);
+        EXPECT_NEAR(sum(hairAlpha(out.film)), expected, 1e-6 * expected);
         EXPECT_GT(out.stats.fragments, std::uint64_t(double(glm::distance(a, b)) * f));
-        for (float alpha : out.film.alpha)
-            ASSERT_LE(alpha, 0.35f); // sub-pixel width: at most width · √2 per pixel
+        for (float x : alpha(out.film))
+            ASSERT_LE(x, 0.35f); // sub-pixel width: at most width · √2 per pixel
     }
 }
 
 TEST(RasterCoverage, WideRibbonGivesTheExactQuadArea) {
     const int size = 128;
-    Scene scene = testScene(size, size, Vec3f(0, 0, 1), Vec3f(0, 0, 0));
-    scene.fiberDiameter = 0.0137f; // 6.5 pixels
+    const Camera camera = testCamera(size, size, Vec3f(0, 0, 1), Vec3f(0, 0, 0));
+    const RasterSettings settings = testSettings(0.0137f); // 6.5 pixels
     const double f = focalPixels(size, 30.0);
     Groom groom;
     const Vec3f a(-0.0731f, -0.0322f, 0.0f), b(0.0655f, 0.0491f, 0.0f);
     addStraightStrand(groom, a, b, 1);
     const test::ConstantShader shader;
-    const RenderOutput out = renderImage(groom, scene, shader);
-    const double expected = double(scene.fiberDiameter) * f * double(glm::distance(a, b)) * f;
-    EXPECT_NEAR(sum(out.film.alpha), expected, 1e-6 * expected); // measured: 1e-8
+    const RasterOutput out = rasterize(groom, camera, shader, settings);
+    const double expected =
+        double(settings.fiberScale.diameter) * f * double(glm::distance(a, b)) * f;
+    EXPECT_NEAR(sum(alpha(out.film)), expected, 1e-6 * expected); // measured: 1e-8
     // The pixel at the ribbon's middle is wholly covered.
-    const Camera camera(scene.camera);
     const Vec2f mid = camera.toRaster(camera.toCamera(0.5f * (a + b)));
-    EXPECT_NEAR(out.film.alpha[out.film.index(int(mid.x), int(mid.y))], 1.0f, 1e-5f);
-    // And the beauty is the shader's constant times the coverage.
-    const Rgb c = test::ConstantShader::result().directR;
     const std::size_t p = out.film.index(int(mid.x), int(mid.y));
-    EXPECT_NEAR(out.film.directR[p].r, c.r, 1e-5f);
+    EXPECT_NEAR(alpha(out.film)[p], 1.0f, 1e-5f);
+    // And each radiance layer is the shader's value there.
+    EXPECT_NEAR(rgb(out.film, "r0", p).r, test::ConstantShader::kR0[0], 1e-5f);
+    EXPECT_NEAR(rgb(out.film, "r1", p).g, test::ConstantShader::kR1[1], 1e-5f);
 }
 
 TEST(RasterCoverage, FiberLeavingTheImageIsClippedNotLost) {
     const int size = 64;
-    Scene scene = testScene(size, size, Vec3f(0, 0, 1), Vec3f(0, 0, 0));
-    scene.fiberDiameter = 1e-3f;
+    const Camera camera = testCamera(size, size, Vec3f(0, 0, 1), Vec3f(0, 0, 0));
     Groom groom;
-    addStraightStrand(groom, Vec3f(-1, 0.01f, 0), Vec3f(1, 0.01f, 0), 10); // far wider than the view
-    addStraightStrand(groom, Vec3f(0, 0, 2), Vec3f(0.1f, 0, 3), 2);       // behind the camera
+    addStraightStrand(groom, Vec3f(-1, 0.01f, 0), Vec3f(1, 0.01f, 0),
+                      10);                                          // far wider than the view
+    addStraightStrand(groom, Vec3f(0, 0, 2), Vec3f(0.1f, 0, 3), 2); // behind the camera
     const test::ConstantShader shader;
-    const RenderOutput out = renderImage(groom, scene, shader);
+    const RasterOutput out = rasterize(groom, camera, shader, testSettings(1e-3f));
     const double f = focalPixels(size, 30.0);
-    EXPECT_NEAR(sum(out.film.alpha), 1e-3 * f * size, 1e-3 * 1e-3 * f * size);
+    EXPECT_NEAR(sum(alpha(out.film)), 1e-3 * f * size, 1e-3 * 1e-3 * f * size);
     EXPECT_EQ(out.stats.segmentsOutsideView, 6u + 2u); // 3 + 3 off-screen pieces, 2 behind
 }
 
@@ -97,20 +113,21 @@ Groom crossingRibbons(float zFirst, float zSecond) {
 
 TEST(RasterCompositing, FrontToBackWithEarlyTermination) {
     const int size = 96;
-    Scene scene = testScene(size, size, Vec3f(0, 0, 1), Vec3f(0, 0, 0));
-    scene.fiberDiameter = 0.05f; // 9 pixels in front, 6 behind
+    const Camera camera = testCamera(size, size, Vec3f(0, 0, 1), Vec3f(0, 0, 0));
+    const RasterSettings settings = testSettings(0.05f); // 9 pixels in front, 6 behind
     const test::StrandColorShader shader;
     const int c = size / 2;
     for (const bool redInFront : {true, false}) {
         SCOPED_TRACE(redInFront);
-        const Groom groom = redInFront ? crossingRibbons(0.0f, -0.5f) : crossingRibbons(-0.5f, 0.0f);
-        const RenderOutput out = renderImage(groom, scene, shader);
+        const Groom groom =
+            redInFront ? crossingRibbons(0.0f, -0.5f) : crossingRibbons(-0.5f, 0.0f);
+        const RasterOutput out = rasterize(groom, camera, shader, settings);
         const Rgb centre = out.film.beauty(out.film.index(c, c));
-        EXPECT_NEAR(out.film.alpha[out.film.index(c, c)], 1.0f, 1e-5f);
+        EXPECT_NEAR(alpha(out.film)[out.film.index(c, c)], 1.0f, 1e-5f);
         EXPECT_NEAR(redInFront ? centre.r : centre.g, 1.0f, 1e-5f);
         EXPECT_EQ(redInFront ? centre.g : centre.r, 0.0f); // the back ribbon was never shaded here
         // Every fragment is either composited (and shaded once) or skipped.
-        const RenderStats& st = out.stats;
+        const RasterStats& st = out.stats;
         EXPECT_EQ(st.fragments, st.fragmentsComposited + st.fragmentsBehindOpaque);
         EXPECT_EQ(st.shadingPoints, st.fragmentsComposited);
         // The back ribbon's fragments inside the front one: about 8 × 6 pixels.
@@ -119,29 +136,35 @@ TEST(RasterCompositing, FrontToBackWithEarlyTermination) {
     }
 }
 
-TEST(RasterCompositing, PartialCoverageCompositesOver) {
-    // Thin ribbons: check c = a_f·red + (1 − a_f)·a_b·green per pixel against
-    // each ribbon's coverage rendered alone.
+TEST(RasterCompositing, PartialCoverageCompositesOverTheBackground) {
+    // Thin ribbons over a background B: per pixel, against each ribbon's
+    // coverage rendered alone (a_f, a_b), the beauty must be
+    //   a_f·red + (1 − a_f)·a_b·green + (1 − a_f)(1 − a_b)·B
+    // — the compositing equation, computed here from the single-ribbon alphas,
+    // not from the film's own layers.
     const int size = 64;
-    Scene scene = testScene(size, size, Vec3f(0, 0, 1), Vec3f(0, 0, 0));
-    scene.fiberDiameter = 1.5e-3f;
+    const Camera camera = testCamera(size, size, Vec3f(0, 0, 1), Vec3f(0, 0, 0));
+    RasterSettings settings = testSettings(1.5e-3f);
+    settings.opaqueTransmittance = 0.0f;
+    settings.background = Rgb(0.1f, 0.2f, 0.4f);
     const test::StrandColorShader shader;
     const Groom both = crossingRibbons(0.0f, -0.3f);
     Groom front, back;
     front.addStrand(both.strand(0));
     back.addStrand(both.strand(1));
-    RenderOptions options;
-    options.opaqueTransmittance = 0.0f;
-    const Film fb = renderImage(both, scene, shader, options).film;
-    const Film ff = renderImage(front, scene, shader, options).film;
-    const Film fk = renderImage(back, scene, shader, options).film;
+    const Film fb = rasterize(both, camera, shader, settings).film;
+    const Film ff = rasterize(front, camera, shader, settings).film;
+    const Film fk = rasterize(back, camera, shader, settings).film;
     int overlapping = 0;
     for (std::size_t p = 0; p < fb.pixelCount(); ++p) {
-        const float af = ff.alpha[p], ab = fk.alpha[p];
+        const float af = alpha(ff)[p], ab = alpha(fk)[p];
         overlapping += af > 0 && ab > 0 ? 1 : 0;
-        EXPECT_NEAR(fb.directR[p].r, af, 1e-6f);
-        EXPECT_NEAR(fb.directR[p].g, (1 - af) * ab, 1e-6f);
-        EXPECT_NEAR(fb.alpha[p], af + (1 - af) * ab, 1e-6f);
+        const Rgb expected =
+            Rgb(af, (1 - af) * ab, 0.0f) + (1 - af) * (1 - ab) * settings.background;
+        const Rgb beauty = fb.beauty(p);
+        for (int ch = 0; ch < 3; ++ch)
+            ASSERT_NEAR(beauty[ch], expected[ch], 1e-6f) << "pixel " << p << " channel " << ch;
+        EXPECT_NEAR(alpha(fb)[p], af + (1 - af) * ab, 1e-6f);
     }
     EXPECT_GE(overlapping, 1);
 }
@@ -149,19 +172,19 @@ TEST(RasterCompositing, PartialCoverageCompositesOver) {
 TEST(RasterCompositing, DensityMultiplierScalesOpacity) {
     // A strand standing for k hairs transmits (1 − α)^k of what is behind it.
     const int size = 64;
-    Scene scene = testScene(size, size, Vec3f(0, 0, 1), Vec3f(0, 0, 0));
-    scene.fiberDiameter = 4e-3f; // 0.5 to 1 pixel: a range of coverages
+    const Camera camera = testCamera(size, size, Vec3f(0, 0, 1), Vec3f(0, 0, 0));
+    RasterSettings settings = testSettings(4e-3f); // 0.5 to 1 pixel: a range of coverages
     Groom groom;
     addStraightStrand(groom, Vec3f(-0.1f, -0.0437f, 0.0f), Vec3f(0.1f, 0.0618f, 0.0f), 1);
     const test::ConstantShader shader;
-    const Film one = renderImage(groom, scene, shader).film;
-    scene.densityMultiplier = 3.5f;
-    const Film many = renderImage(groom, scene, shader).film;
+    const Film one = rasterize(groom, camera, shader, settings).film;
+    settings.fiberScale.densityMultiplier = 3.5f;
+    const Film many = rasterize(groom, camera, shader, settings).film;
     int partial = 0;
     for (std::size_t p = 0; p < one.pixelCount(); ++p) {
-        EXPECT_NEAR(many.alpha[p], 1 - std::pow(1 - one.alpha[p], 3.5f), 1e-5f);
-        EXPECT_NEAR(many.directR[p].r, 0.5f * many.alpha[p], 1e-5f);
-        partial += one.alpha[p] > 0.05f && one.alpha[p] < 0.95f ? 1 : 0;
+        EXPECT_NEAR(alpha(many)[p], 1 - std::pow(1 - alpha(one)[p], 3.5f), 1e-5f);
+        EXPECT_NEAR(rgb(many, "r0", p).r, 0.5f * alpha(many)[p], 1e-5f);
+        partial += alpha(one)[p] > 0.05f && alpha(one)[p] < 0.95f ? 1 : 0;
     }
     EXPECT_GT(partial, 30);
 }
@@ -169,16 +192,15 @@ TEST(RasterCompositing, DensityMultiplierScalesOpacity) {
 TEST(RasterCoverage, StrandsThroughTheNearPlaneAreClipped) {
     // The camera inside the hair: segments cross the near plane (1 mm here).
     const int size = 64;
-    Scene scene = testScene(size, size, Vec3f(0, 0, 1), Vec3f(0, 0, 0));
-    scene.fiberDiameter = 1e-4f;
+    const Camera camera = testCamera(size, size, Vec3f(0, 0, 1), Vec3f(0, 0, 0));
     Groom groom;
     addStraightStrand(groom, Vec3f(0.001f, 0.0005f, 1.5f), Vec3f(0.05f, 0.02f, -0.5f), 4);
     addStraightStrand(groom, Vec3f(-0.02f, 0.01f, 0.9995f), Vec3f(0.02f, 0.01f, 0.9995f), 3);
     const test::ConstantShader shader;
-    const RenderOutput out = renderImage(groom, scene, shader);
+    const RasterOutput out = rasterize(groom, camera, shader, testSettings(1e-4f));
     for (std::size_t p = 0; p < out.film.pixelCount(); ++p) {
         ASSERT_TRUE(out.film.beauty(p).isFinite());
-        ASSERT_GE(out.film.depth[p], 0.0f);
+        ASSERT_GE(depth(out.film)[p], 0.0f);
     }
     EXPECT_GT(out.stats.fragmentsComposited, 0u);
     EXPECT_GE(out.stats.segmentsOutsideView, 3u); // the second strand and the part behind
@@ -186,80 +208,104 @@ TEST(RasterCoverage, StrandsThroughTheNearPlaneAreClipped) {
 
 TEST(RasterCoverage, AbsurdCoordinatesAreSafe) {
     const int size = 32;
-    Scene scene = testScene(size, size, Vec3f(0, 0, 1), Vec3f(0, 0, 0));
+    const Camera camera = testCamera(size, size, Vec3f(0, 0, 1), Vec3f(0, 0, 0));
     Groom groom;
     addStraightStrand(groom, Vec3f(-3e38f, 0, 0), Vec3f(3e38f, 1e-3f, 0), 2); // overflows
-    addStraightStrand(groom, Vec3f(-1e12f, 0, 0), Vec3f(1e12f, 0.01f, 0), 1);  // vast but finite
-    addStraightStrand(groom, Vec3f(0, 0, 0.5f), Vec3f(1e-7f, 0, 0.5f), 1);      // tiny
+    addStraightStrand(groom, Vec3f(-1e12f, 0, 0), Vec3f(1e12f, 0.01f, 0), 1); // vast but finite
+    addStraightStrand(groom, Vec3f(0, 0, 0.5f), Vec3f(1e-7f, 0, 0.5f), 1);    // tiny
     const test::ConstantShader shader;
-    const RenderOutput out = renderImage(groom, scene, shader);
+    const RasterOutput out = rasterize(groom, camera, shader, testSettings(7e-5f));
     for (std::size_t p = 0; p < out.film.pixelCount(); ++p)
-        ASSERT_TRUE(out.film.beauty(p).isFinite() && std::isfinite(out.film.depth[p]));
+        ASSERT_TRUE(out.film.beauty(p).isFinite() && std::isfinite(depth(out.film)[p]));
     EXPECT_GT(out.stats.fragmentsComposited, 0u); // the vast strand crosses the view
 }
 
-TEST(RasterHead, HidesHairBehindItAndIsDrawn) {
-    const int size = 128;
-    Scene scene = testScene(size, size, Vec3f(0, 0, 1), Vec3f(0, 0, 0));
-    scene.fiberDiameter = 2e-3f;
-    scene.head = Head{Sphere{Vec3f(0.0f), 0.1f}, Rgb(0.5f, 0.4f, 0.3f)};
-    scene.lights.push_back(Light{LightGeometry::directional(Vec3f(0, 0, 1)), "key", Rgb(1.0f), 2.0f});
-    const test::ConstantShader shader;
-    Groom groom;
-    addStraightStrand(groom, Vec3f(-0.02f, 0.01f, -0.3f), Vec3f(0.02f, 0.01f, -0.3f), 4);
-    const RenderOutput hidden = renderImage(groom, scene, shader);
-    EXPECT_EQ(hidden.stats.segmentsBehindHead, 4u);
-    EXPECT_EQ(sum(hidden.film.hairAlpha), 0.0);
-    // The head: Lambertian, lit head-on at the centre: albedo/π · E.
-    const std::size_t c = hidden.film.index(size / 2, size / 2);
-    EXPECT_NEAR(hidden.film.head[c].r, 0.5f * 2.0f / float(Pi), 1e-3f);
-    EXPECT_NEAR(hidden.film.alpha[c], 1.0f, 1e-6f);
-    EXPECT_GT(hidden.film.depth[c], 0.89f);
-    EXPECT_LT(hidden.film.depth[c], 0.91f);
+/// A surface layer: a disc of radius r pixels around the image centre at
+/// `depthValue`, coverage 1 inside, radiance `radiance`.
+SurfaceLayer discSurface(const Camera& camera, float r, float depthValue, const Rgb& radiance) {
+    SurfaceLayer s;
+    const std::size_t pixels = std::size_t(camera.width()) * std::size_t(camera.height());
+    s.coverage.assign(pixels, 0.0f);
+    s.depth.assign(pixels, 0.0f);
+    s.radiance.assign(pixels, Rgb(0.0f));
+    for (int y = 0; y < camera.height(); ++y)
+        for (int x = 0; x < camera.width(); ++x) {
+            const float dx = float(x) + 0.5f - 0.5f * float(camera.width());
+            const float dy = float(y) + 0.5f - 0.5f * float(camera.height());
+            if (dx * dx + dy * dy < r * r) {
+                const std::size_t p = std::size_t(y) * std::size_t(camera.width()) + std::size_t(x);
+                s.coverage[p] = 1.0f;
+                s.depth[p] = depthValue;
+                s.radiance[p] = radiance;
+            }
+        }
+    return s;
+}
 
-    // A strand across the whole view behind the head: visible only outside it.
+TEST(RasterSurfaces, HideHairBehindThemAndAreComposited) {
+    const int size = 128;
+    const Camera camera = testCamera(size, size, Vec3f(0, 0, 1), Vec3f(0, 0, 0));
+    const RasterSettings settings = testSettings(2e-3f);
+    const Rgb surfaceRadiance(0.3f, 0.2f, 0.1f);
+    const SurfaceLayer disc = discSurface(camera, 50.0f, 0.9f, surfaceRadiance);
+    const test::ConstantShader shader;
+    // A short strand wholly behind the disc: culled before rasterization.
+    Groom hidden;
+    addStraightStrand(hidden, Vec3f(-0.02f, 0.01f, -0.3f), Vec3f(0.02f, 0.01f, -0.3f), 4);
+    const RasterOutput h = rasterize(hidden, camera, shader, settings, disc);
+    EXPECT_GE(h.stats.segmentTilesBehindSurfaces, 4u);
+    EXPECT_EQ(h.stats.fragments, 0u);
+    EXPECT_EQ(sum(hairAlpha(h.film)), 0.0);
+    const std::size_t c = h.film.index(size / 2, size / 2);
+    EXPECT_EQ(h.film.layer(kSurfaceLayer).rgb(c), surfaceRadiance);
+    EXPECT_EQ(h.film.beauty(c), surfaceRadiance);
+    EXPECT_EQ(alpha(h.film)[c], 1.0f);
+    EXPECT_EQ(depth(h.film)[c], 0.9f);
+
+    // A strand across the whole view behind the disc: visible only outside it.
     Groom across;
     addStraightStrand(across, Vec3f(-0.4f, 0.0f, -0.3f), Vec3f(0.4f, 0.0f, -0.3f), 40);
-    const RenderOutput out = renderImage(across, scene, shader);
-    const Camera camera(scene.camera);
-    const float headRadiusPixels = 0.1f * camera.focalLength() / 1.0f;
+    const RasterOutput out = rasterize(across, camera, shader, settings, disc);
     const int y = size / 2;
     for (int x = 0; x < size; ++x) {
         const float r = std::abs(float(x) + 0.5f - float(size) / 2);
         const std::size_t p = out.film.index(x, y);
-        if (r < headRadiusPixels - 1.5f) {
-            EXPECT_EQ(out.film.hairAlpha[p], 0.0f) << x;
-        } else if (r > headRadiusPixels + 1.5f) {
-            EXPECT_GT(out.film.hairAlpha[p], 0.0f) << x;
+        if (r < 49.0f) {
+            EXPECT_EQ(hairAlpha(out.film)[p], 0.0f) << x;
+        } else if (r > 51.0f) {
+            EXPECT_GT(hairAlpha(out.film)[p], 0.0f) << x;
         }
     }
-    EXPECT_GE(out.stats.segmentsBehindHead, 8u);
+    // The same strand in front of the disc covers it.
+    Groom inFront;
+    addStraightStrand(inFront, Vec3f(-0.4f, 0.0f, 0.5f), Vec3f(0.4f, 0.0f, 0.5f), 40);
+    const RasterOutput front = rasterize(inFront, camera, shader, settings, disc);
+    EXPECT_GT(hairAlpha(front.film)[front.film.index(size / 2, y)], 0.0f);
+    EXPECT_EQ(front.stats.segmentTilesBehindSurfaces, 0u);
 }
 
-/// The film's planes, concatenated as bytes.
+TEST(RasterSurfaces, WrongSizeIsAnInputError) {
+    const Camera camera = testCamera(16, 16, Vec3f(0, 0, 1), Vec3f(0, 0, 0));
+    SurfaceLayer bad;
+    bad.coverage.assign(10, 1.0f);
+    bad.depth.assign(10, 1.0f);
+    bad.radiance.assign(10, Rgb(1.0f));
+    const test::ConstantShader shader;
+    EXPECT_THROW(rasterize(Groom{}, camera, shader, testSettings(1e-3f), bad), InputError);
+}
+
+/// Every layer of the film, concatenated as bytes.
 std::vector<unsigned char> filmBytes(const Film& film) {
     std::vector<unsigned char> bytes;
-    auto add = [&](const auto& v) {
-        const auto* p = reinterpret_cast<const unsigned char*>(v.data());
-        bytes.insert(bytes.end(), p, p + v.size() * sizeof(v[0]));
-    };
-    for (const auto* layer : {&film.directR, &film.directTT, &film.directTRT, &film.backDirect,
-                              &film.scatter, &film.head, &film.background, &film.T_s,
-                              &film.sigma_f})
-        add(*layer);
-    for (const auto* plane : {&film.alpha, &film.hairAlpha, &film.depth, &film.V, &film.n})
-        add(*plane);
+    for (const FilmLayer& layer : film.layers()) {
+        const auto* p = reinterpret_cast<const unsigned char*>(layer.data.data());
+        bytes.insert(bytes.end(), p, p + layer.data.size() * sizeof(float));
+    }
     return bytes;
 }
 
-Scene groomScene(std::uint32_t size) {
-    Scene scene = testScene(size, size, Vec3f(0.45f, 0.05f, -0.6f), Vec3f(0.0f, -0.1f, -0.05f));
-    scene.head = Head{};
-    scene.lights.push_back(Light{LightGeometry::directional(glm::normalize(Vec3f(0.6f, 0.7f, 0.4f))), "key", Rgb(1.0f),
-                                 3.0f});
-    scene.lights.push_back(Light{LightGeometry::point(Vec3f(-0.5f, 0.3f, -0.8f)), "fill", Rgb(0.5f, 0.6f, 1.0f), 0.2f});
-    scene.background = Rgb(0.05f);
-    return scene;
+Camera groomCamera(std::uint32_t size) {
+    return testCamera(size, size, Vec3f(0.45f, 0.05f, -0.6f), Vec3f(0.0f, -0.1f, -0.05f));
 }
 
 Groom smallGroom(std::uint32_t strands) {
@@ -270,16 +316,19 @@ Groom smallGroom(std::uint32_t strands) {
 
 TEST(RasterDeterminism, SameBytesForAnyThreadCount) {
     const Groom groom = smallGroom(1500);
+    const Camera camera = groomCamera(160);
+    const test::SmoothShader shader(2);
     for (const ShadingRate rate : {ShadingRate::Fragment, ShadingRate::Vertex}) {
         SCOPED_TRACE(toString(rate));
-        Scene scene = groomScene(160);
-        scene.shadingRate = rate;
-        const test::SmoothShader shader(scene.lights.size());
+        RasterSettings settings = testSettings(7e-5f);
+        settings.shadingRate = rate;
+        settings.background = Rgb(0.05f);
+        // A surface in the middle of the hair: its pixels close, hair behind is skipped.
+        const SurfaceLayer surface = discSurface(camera, 40.0f, 0.75f, Rgb(0.2f));
         std::vector<unsigned char> reference;
         for (const int threads : {1, 2, 8}) {
-            RenderOptions options;
-            options.threads = threads;
-            const RenderOutput out = renderImage(groom, scene, shader, options);
+            settings.threads = threads;
+            const RasterOutput out = rasterize(groom, camera, shader, settings, surface);
             EXPECT_GT(out.stats.fragmentsComposited, 10000u);
             EXPECT_GT(out.stats.fragmentsBehindOpaque, 0u);
             if (reference.empty())
@@ -292,16 +341,17 @@ TEST(RasterDeterminism, SameBytesForAnyThreadCount) {
 
 TEST(RasterShadingRate, VertexShadingApproximatesFragmentShading) {
     const Groom groom = smallGroom(2000);
-    Scene scene = groomScene(200);
-    const test::SmoothShader shader(scene.lights.size());
-    const RenderOutput perFragment = renderImage(groom, scene, shader);
-    scene.shadingRate = ShadingRate::Vertex;
-    const RenderOutput perVertex = renderImage(groom, scene, shader);
+    const Camera camera = groomCamera(200);
+    const test::SmoothShader shader(2);
+    RasterSettings settings = testSettings(7e-5f);
+    const RasterOutput perFragment = rasterize(groom, camera, shader, settings);
+    settings.shadingRate = ShadingRate::Vertex;
+    const RasterOutput perVertex = rasterize(groom, camera, shader, settings);
     // Coverage does not depend on the shading rate.
-    EXPECT_TRUE(perFragment.film.alpha == perVertex.film.alpha);
+    EXPECT_TRUE(alpha(perFragment.film) == alpha(perVertex.film));
     double diff = 0, total = 0;
     for (std::size_t p = 0; p < perFragment.film.pixelCount(); ++p) {
-        if (perFragment.film.hairAlpha[p] == 0)
+        if (hairAlpha(perFragment.film)[p] == 0)
             continue;
         const Rgb a = perFragment.film.beauty(p), b = perVertex.film.beauty(p);
         for (int c = 0; c < 3; ++c) {
@@ -315,30 +365,27 @@ TEST(RasterShadingRate, VertexShadingApproximatesFragmentShading) {
     EXPECT_LT(perVertex.stats.shadingPoints, perFragment.stats.shadingPoints);
 }
 
-TEST(RasterFilm, BeautyIsTheSumOfItsLayersAndAovsAreAverages) {
+TEST(RasterFilm, RadianceIsPremultipliedAndAveragesAreNot) {
     const Groom groom = smallGroom(800);
-    const Scene scene = groomScene(96);
-    const test::ConstantShader shader;
-    const Film film = renderImage(groom, scene, shader).film;
-    const GlobalTerm g = test::ConstantShader::term();
+    const Camera camera = groomCamera(96);
+    RasterSettings settings = testSettings(7e-5f);
+    settings.background = Rgb(0.05f);
+    const test::ConstantShader shader(2);
+    const Film film = rasterize(groom, camera, shader, settings).film;
     int hairPixels = 0;
     for (std::size_t p = 0; p < film.pixelCount(); ++p) {
-        const Rgb expected = film.directR[p] + film.directTT[p] + film.directTRT[p] +
-                             film.backDirect[p] + film.scatter[p] + film.head[p] +
-                             film.background[p];
-        ASSERT_EQ(film.beauty(p), expected);
-        ASSERT_NEAR(film.background[p].r, 0.05f * (1 - film.alpha[p]), 1e-6f);
-        if (film.hairAlpha[p] < 1e-3f)
+        ASSERT_NEAR(film.layer(kBackgroundLayer).rgb(p).r, 0.05f * (1 - alpha(film)[p]), 1e-6f);
+        if (hairAlpha(film)[p] < 1e-3f)
             continue;
         ++hairPixels;
         // Premultiplied hair radiance: the constant times the hair's coverage.
-        ASSERT_NEAR(film.directR[p].r, 0.5f * film.hairAlpha[p], 1e-5f);
-        for (std::size_t l = 0; l < film.lightCount(); ++l) {
-            const std::size_t i = l * film.pixelCount() + p;
-            ASSERT_NEAR(film.V[i], g.V, 1e-4f);
-            ASSERT_NEAR(film.n[i], g.n, 1e-3f);
-            ASSERT_NEAR(film.T_s[i].b, g.T_s.b, 1e-4f);
-            ASSERT_NEAR(film.sigma_f[i].r, 0.2f, 1e-4f);
+        ASSERT_NEAR(rgb(film, "r0", p).r, test::ConstantShader::kR0[0] * hairAlpha(film)[p], 1e-5f);
+        // Averages: the constant itself, whatever the coverage.
+        for (const char* light : {"light0", "light1"}) {
+            ASSERT_NEAR(film.layer(std::string(light) + ".V").scalar(p),
+                        test::ConstantShader::kLight[0], 1e-5f);
+            ASSERT_NEAR(film.layer(std::string(light) + ".T_s").rgb(p).b,
+                        test::ConstantShader::kLight[3], 1e-5f);
         }
     }
     EXPECT_GT(hairPixels, 500);
@@ -346,9 +393,8 @@ TEST(RasterFilm, BeautyIsTheSumOfItsLayersAndAovsAreAverages) {
 
 TEST(RasterFilm, RejectsNonFiniteShaderResultsAndReportsThePixel) {
     const Groom groom = smallGroom(300);
-    const Scene scene = groomScene(64);
     const test::NaNShader shader;
-    const RenderOutput out = renderImage(groom, scene, shader);
+    const RasterOutput out = rasterize(groom, groomCamera(64), shader, testSettings(7e-5f));
     EXPECT_GT(out.stats.invalidSamples, 0u);
     ASSERT_FALSE(out.warnings.empty());
     EXPECT_NE(out.warnings[0].find("at pixel ("), std::string::npos) << out.warnings[0];
@@ -356,24 +402,26 @@ TEST(RasterFilm, RejectsNonFiniteShaderResultsAndReportsThePixel) {
         ASSERT_TRUE(out.film.beauty(p).isFinite());
 }
 
-TEST(RasterFilm, NoLightsAndAnEmptyGroomRender) {
-    Scene scene = groomScene(32);
-    scene.lights.clear();
+TEST(RasterFilm, AnEmptyGroomRendersTheSurfacesAndBackground) {
+    const Camera camera = groomCamera(32);
+    RasterSettings settings = testSettings(7e-5f);
+    settings.background = Rgb(0.25f);
     const test::ConstantShader shader;
-    const RenderOutput empty = renderImage(Groom{}, scene, shader);
+    const SurfaceLayer disc = discSurface(camera, 8.0f, 0.5f, Rgb(1.0f));
+    const RasterOutput empty = rasterize(Groom{}, camera, shader, settings, disc);
     EXPECT_EQ(empty.stats.fragments, 0u);
-    EXPECT_EQ(empty.film.lightCount(), 0u);
-    EXPECT_GT(sum(empty.film.alpha), 0.0); // the head
+    EXPECT_NEAR(sum(alpha(empty.film)), sum(disc.coverage), 1e-6);
+    EXPECT_EQ(empty.film.beauty(0), Rgb(0.25f));
 }
 
 TEST(RasterInterrupt, StopsBetweenTiles) {
     const Groom groom = smallGroom(200);
-    const Scene scene = groomScene(64);
+    const Camera camera = groomCamera(64);
     const test::ConstantShader shader;
     requestInterrupt();
-    EXPECT_THROW(renderImage(groom, scene, shader), Interrupted);
+    EXPECT_THROW(rasterize(groom, camera, shader, testSettings(7e-5f)), Interrupted);
     clearInterrupt();
-    EXPECT_NO_THROW(renderImage(groom, scene, shader));
+    EXPECT_NO_THROW(rasterize(groom, camera, shader, testSettings(7e-5f)));
 }
 
 } // namespace

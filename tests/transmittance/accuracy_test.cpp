@@ -26,18 +26,19 @@ namespace {
 class Probe {
 public:
     Probe(std::string name, Groom groom, double referenceVoxel)
-        : name_(std::move(name)), groom_(std::move(groom)) {
+        : name_(std::move(name))
+        , groom_(std::move(groom)) {
         test::TempDir cache;
         crossings_ = CrossingTable::fromDualScattering(
             DualScatteringTables::loadOrBuild(FiberParams{}, cache.path()));
-        settings_.fiberDiameter = 7e-5f;
+        settings_.fiberScale.diameter = 7e-5f;
         points_ = sampleFiberPoints(groom_, 300, 7);
         ExactOptions exact;
         exact.rays = 256;
         exact.radius = static_cast<float>(referenceVoxel); // the footprint the grid resolves
         const auto model = makeExactModel(groom_, crossings_, settings_, exact);
         for (const Vec3f& l : lights_)
-            reference_.push_back(evaluateGlobalTerm(*model, LightGeometry::directional(l), points_));
+            reference_.push_back(evaluateGlobalTerm(*model, Light::directional(l), points_));
     }
 
     struct Result {
@@ -53,8 +54,7 @@ public:
         const auto start = std::chrono::steady_clock::now();
         for (std::size_t l = 0; l < lights_.size(); ++l) {
             const ProbeError e = compareGlobalTerms(
-                evaluateGlobalTerm(*model, LightGeometry::directional(lights_[l]), points_),
-                reference_[l]);
+                evaluateGlobalTerm(*model, Light::directional(lights_[l]), points_), reference_[l]);
             r.error.maeV += e.maeV / double(lights_.size());
             r.error.maeT_s += e.maeT_s / double(lights_.size());
             r.error.biasN += e.biasN / double(lights_.size());
@@ -82,8 +82,8 @@ public:
 private:
     std::string name_;
     Groom groom_;
-    CrossingTable crossings_ = CrossingTable::build([](float) { return Rgb(1.0f); },
-                                                    [](float) { return Rgb(0.0f); });
+    CrossingTable crossings_ =
+        CrossingTable::build([](float) { return Rgb(1.0f); }, [](float) { return Rgb(0.0f); });
     GlobalTermSettings settings_;
     std::vector<GlobalTermQuery> points_;
     std::vector<Vec3f> lights_{glm::normalize(Vec3f(0.3f, 1, 0.4f)),
@@ -100,7 +100,8 @@ Groom procedural(GroomStyle style, std::uint32_t strands) {
 }
 
 TEST(GlobalTermAccuracySlow, ConvergesAsVoxelsShrink) {
-    std::printf("grid (default options) against exact, K = 256 rays of radius h0 = default voxel:\n");
+    std::printf(
+        "grid (default options) against exact, K = 256 rays of radius h0 = default voxel:\n");
     for (const auto& [name, groom] :
          {std::pair{std::string("wavy"), procedural(GroomStyle::Wavy, 6000)},
           std::pair{std::string("curly"), procedural(GroomStyle::Curly, 6000)},
@@ -110,9 +111,11 @@ TEST(GlobalTermAccuracySlow, ConvergesAsVoxelsShrink) {
         const Probe probe(name, groom, h0);
         std::vector<double> maeV, maeT_s;
         for (const double scale : {4.0, 2.0, 1.0}) {
-            const Probe::Result r = probe.measure(probe.splat(h0 * scale), GlobalTermMode::Grid, {});
+            const Probe::Result r =
+                probe.measure(probe.splat(h0 * scale), GlobalTermMode::Grid, {});
             char label[64];
-            std::snprintf(label, sizeof(label), "h = %.2f mm (%.0f x default)", h0 * scale * 1e3, scale);
+            std::snprintf(label, sizeof(label), "h = %.2f mm (%.0f x default)", h0 * scale * 1e3,
+                          scale);
             probe.print(label, r);
             maeV.push_back(r.error.maeV);
             maeT_s.push_back(r.error.maeT_s);
@@ -148,7 +151,8 @@ TEST(GlobalTermAccuracySlow, OrientationRepresentationOnCurlyHair) {
     const FiberGrid grid = probe.splat(h, true);
     std::map<OrientationModel, Probe::Result> results;
     for (const OrientationModel model :
-         {OrientationModel::MeanTangent, OrientationModel::CoherenceBlend, OrientationModel::Tensor}) {
+         {OrientationModel::MeanTangent, OrientationModel::CoherenceBlend,
+          OrientationModel::Tensor}) {
         GridOptions options;
         options.orientation = model;
         results[model] = probe.measure(grid, GlobalTermMode::Grid, options);

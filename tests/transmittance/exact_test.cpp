@@ -14,7 +14,7 @@ using test::constantTable;
 using test::slabSettings;
 constexpr float kDiameter = test::kSlabDiameter;
 
-GlobalTerm evaluateAt(const GlobalTermModel& model, const LightGeometry& light, const Vec3f& p,
+GlobalTerm evaluateAt(const GlobalTermModel& model, const Light& light, const Vec3f& p,
                       const Vec3f& tangent = Vec3f(1, 0, 0)) {
     GlobalTerm out;
     const GlobalTermQuery q{p, tangent};
@@ -33,13 +33,13 @@ void expectSlabMatchesPoissonClosedForms(float densityMultiplier) {
     options.rays = 64;
     options.radius = 0.004f;
     GlobalTermSettings s = slabSettings();
-    s.densityMultiplier = densityMultiplier;
+    s.fiberScale.densityMultiplier = densityMultiplier;
     const auto model = makeExactModel(groom, constantTable(aBar, 0.02f), s, options);
 
     for (const Vec3f dir : {Vec3f(0, 1, 0), Vec3f(0.5f, 1, 0), Vec3f(0, 1, 0.6f),
                             Vec3f(-0.4f, 1, 0.4f), Vec3f(0.8f, 1, -0.2f)}) {
         const Vec3f omega = glm::normalize(dir);
-        const auto light = model->forLight(LightGeometry::directional(omega));
+        const auto light = model->forLight(Light::directional(omega));
         // Random points 5 mm below the slab (so that the tilted disk of ray
         // origins stays below it), far enough from the edges that no ray
         // leaves the slab sideways.
@@ -86,7 +86,7 @@ TEST(ExactGlobalTerm, EmptySpaceIsExactlyUnoccluded) {
     // Above the slab looking up, and beside it looking sideways: nothing in front.
     for (const auto& [p, dir] : {std::pair{Vec3f(0, 0.05f, 0), Vec3f(0, 1, 0)},
                                  std::pair{Vec3f(0, 0.005f, 0.2f), Vec3f(0, 0, 1)}}) {
-        const GlobalTerm g = evaluateAt(*model, LightGeometry::directional(dir), p);
+        const GlobalTerm g = evaluateAt(*model, Light::directional(dir), p);
         EXPECT_EQ(g.n, 0.0f);
         EXPECT_EQ(g.V, 1.0f);
         EXPECT_EQ(g.P, Rgb(1.0f));
@@ -107,8 +107,8 @@ TEST(ExactGlobalTerm, OwnFiberDoesNotShadowItself) {
         const Vec3f p = lerp(t, line[1], line[2]);
         for (const Vec3f dir :
              {Vec3f(0, 1, 0), Vec3f(1, 0.1f, 0), Vec3f(0.3f, -1, 0.2f), Vec3f(-1, -0.05f, 0)}) {
-            const GlobalTerm g = evaluateAt(*model, LightGeometry::directional(dir), p,
-                                            glm::normalize(line[2] - line[1]));
+            const GlobalTerm g =
+                evaluateAt(*model, Light::directional(dir), p, glm::normalize(line[2] - line[1]));
             EXPECT_EQ(g.n, 0.0f) << "t=" << t << " dir=" << dir;
         }
     }
@@ -128,40 +128,10 @@ TEST(ExactGlobalTerm, CurlComingBackCounts) {
     for (const std::uint32_t hint : {kUnknownStrand, 0u}) {
         GlobalTerm g;
         const GlobalTermQuery q{Vec3f(0, 0, 0), Vec3f(1, 0, 0), hint};
-        model->forLight(LightGeometry::directional(Vec3f(0, 1, 0)))->evaluate({&q, 1}, {&g, 1});
+        model->forLight(Light::directional(Vec3f(0, 1, 0)))->evaluate({&q, 1}, {&g, 1});
         EXPECT_EQ(g.n, 1.0f);
         EXPECT_NEAR(g.P.r, 0.5f, 1e-5f);
     }
-}
-
-TEST(ExactGlobalTerm, JointOfTwoSegmentsIsOneCrossing) {
-    Groom groom;
-    // A strand with a vertex exactly on the ray.
-    const Vec3f bent[3] = {{-0.01f, 0.005f, 0}, {0, 0.005f, 0}, {0.01f, 0.006f, 0}};
-    groom.addStrand(bent);
-    const StrandRayCaster caster(groom, kDiameter);
-    std::vector<FiberCrossing> hits;
-    caster.crossings(Vec3f(0, 0, 0), Vec3f(0, 1, 0), 1.0f, hits);
-    ASSERT_EQ(hits.size(), 1u);
-    EXPECT_NEAR(hits[0].t, 0.005f, 1e-4f);
-    // A curl that loops back across the ray counts each time it crosses.
-    Groom loop;
-    const Vec3f curl[5] = {{-0.01f, 0.002f, 0},
-                           {0.01f, 0.002f, 0},
-                           {0.01f, 0.004f, 0.0005f},
-                           {-0.01f, 0.004f, -0.0005f},
-                           {-0.01f, 0.006f, 0.001f}};
-    loop.addStrand(curl);
-    StrandRayCaster(loop, kDiameter).crossings(Vec3f(0, 0, 0), Vec3f(0, 1, 0), 1.0f, hits);
-    ASSERT_EQ(hits.size(), 2u);
-    EXPECT_NEAR(hits[1].arcLength - hits[0].arcLength, 0.02206f, 1e-4f); // half + turn + half
-    const StrandRayCaster loopCaster(loop, kDiameter);
-    const auto on = loopCaster.locate(Vec3f(0.005f, 0.002f, 0));
-    ASSERT_TRUE(on.has_value());
-    EXPECT_EQ(on->segment, 0u);
-    EXPECT_NEAR(on->arcLength, 0.015f, 1e-5f);
-    EXPECT_EQ(loopCaster.locate(Vec3f(0.005f, 0.002f, 0), 0)->segment, 0u); // with a strand hint
-    EXPECT_FALSE(loopCaster.locate(Vec3f(0, 0.5f, 0)).has_value());
 }
 
 TEST(ExactGlobalTerm, OccluderBlocksLight) {
@@ -169,7 +139,7 @@ TEST(ExactGlobalTerm, OccluderBlocksLight) {
     GlobalTermSettings s = slabSettings();
     s.occluder = Sphere{Vec3f(0, 0.05f, 0), 0.01f};
     const auto model = makeExactModel(slab.groom(), constantTable(0.5f, 0.01f), s, {});
-    const auto light = model->forLight(LightGeometry::point(Vec3f(0, 0.1f, 0)));
+    const auto light = model->forLight(Light::point(Vec3f(0, 0.1f, 0)));
     const GlobalTermQuery queries[2] = {{Vec3f(0, -0.001f, 0), Vec3f(1, 0, 0)},
                                         {Vec3f(0.04f, -0.001f, 0), Vec3f(1, 0, 0)}};
     GlobalTerm out[2];
@@ -187,7 +157,7 @@ TEST(ExactGlobalTerm, IndependentOfBatchingAndOrder) {
     options.radius = 0.002f;
     const auto model =
         makeExactModel(slab.groom(), constantTable(0.5f, 0.01f), slabSettings(), options);
-    const auto light = model->forLight(LightGeometry::directional(Vec3f(0.3f, 1, 0.1f)));
+    const auto light = model->forLight(Light::directional(Vec3f(0.3f, 1, 0.1f)));
     std::vector<GlobalTermQuery> queries;
     for (int i = 0; i < 50; ++i)
         queries.push_back({Vec3f(0.001f * float(i), 0.003f, 0.0f), Vec3f(1, 0, 0)});
@@ -212,12 +182,12 @@ TEST(GlobalTermOccluder, PointLightInsideTheHeadReachesNothing) {
     GlobalTermSettings s = slabSettings();
     s.occluder = Sphere{Vec3f(0, 0.05f, 0), 0.01f};
     const auto model = makeExactModel(slab.groom(), constantTable(0.5f, 0.01f), s, {});
-    EXPECT_TRUE(model->forLight(LightGeometry::point(Vec3f(0, 0.052f, 0)))->blocksEverything());
-    EXPECT_FALSE(model->forLight(LightGeometry::point(Vec3f(0, 0.1f, 0)))->blocksEverything());
-    EXPECT_FALSE(model->forLight(LightGeometry::directional(Vec3f(0, 1, 0)))->blocksEverything());
+    EXPECT_TRUE(model->forLight(Light::point(Vec3f(0, 0.052f, 0)))->blocksEverything());
+    EXPECT_FALSE(model->forLight(Light::point(Vec3f(0, 0.1f, 0)))->blocksEverything());
+    EXPECT_FALSE(model->forLight(Light::directional(Vec3f(0, 1, 0)))->blocksEverything());
     s.occluder.reset();
     EXPECT_FALSE(makeExactModel(slab.groom(), constantTable(0.5f, 0.01f), s, {})
-                     ->forLight(LightGeometry::point(Vec3f(0, 0.052f, 0)))
+                     ->forLight(Light::point(Vec3f(0, 0.052f, 0)))
                      ->blocksEverything());
 }
 

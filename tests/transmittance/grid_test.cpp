@@ -37,7 +37,7 @@ TEST(GridGlobalTerm, SlabMatchesClosedForms) {
         for (const Vec3f dir : {Vec3f(0, 1, 0), Vec3f(0.5f, 1, 0), Vec3f(0, 1, 0.6f),
                                 Vec3f(-0.4f, 1, 0.4f), Vec3f(0.8f, 1, -0.2f)}) {
             const Vec3f omega = glm::normalize(dir);
-            const auto light = gridModel->forLight(LightGeometry::directional(omega));
+            const auto light = gridModel->forLight(Light::directional(omega));
             std::vector<GlobalTermQuery> queries;
             Pcg32 rng(5);
             for (int i = 0; i < 200; ++i)
@@ -74,7 +74,7 @@ TEST(GridGlobalTerm, EmptySpaceIsExactlyUnoccluded) {
             GlobalTerm g;
             const GlobalTermQuery q{p, Vec3f(1, 0, 0)};
             const GlobalTermStats stats =
-                model->forLight(LightGeometry::directional(dir))->evaluate({&q, 1}, {&g, 1});
+                model->forLight(Light::directional(dir))->evaluate({&q, 1}, {&g, 1});
             EXPECT_EQ(g.n, 0.0f);
             EXPECT_EQ(g.V, 1.0f);
             EXPECT_EQ(g.P, Rgb(1.0f));
@@ -100,8 +100,8 @@ TEST(GridGlobalTerm, CrossingCountIsSymmetric) {
         const Vec3f omega = glm::normalize(b - a);
         GlobalTerm up, down;
         const GlobalTermQuery qa{a, Vec3f(1, 0, 0)}, qb{b, Vec3f(1, 0, 0)};
-        model->forLight(LightGeometry::directional(omega))->evaluate({&qa, 1}, {&up, 1});
-        model->forLight(LightGeometry::directional(-omega))->evaluate({&qb, 1}, {&down, 1});
+        model->forLight(Light::directional(omega))->evaluate({&qa, 1}, {&up, 1});
+        model->forLight(Light::directional(-omega))->evaluate({&qb, 1}, {&down, 1});
         EXPECT_GT(up.n, 0.5f);
         EXPECT_NEAR(up.n, down.n, 1e-5f * up.n) << a << " " << b;
     }
@@ -116,11 +116,11 @@ TEST(GridGlobalTerm, PoissonKeepsTransmittanceNonNegativeWhereGeometricCannot) {
     GridOptions options;
     options.estimator = AttenuationEstimator::Poisson;
     makeGridModel(grid, constantTable(0.2f, 0.01f), slabSettings(), options)
-        ->forLight(LightGeometry::directional(Vec3f(0, 1, 0)))
+        ->forLight(Light::directional(Vec3f(0, 1, 0)))
         ->evaluate({&q, 1}, {&poisson, 1});
     options.estimator = AttenuationEstimator::Geometric;
     makeGridModel(grid, constantTable(0.2f, 0.01f), slabSettings(), options)
-        ->forLight(LightGeometry::directional(Vec3f(0, 1, 0)))
+        ->forLight(Light::directional(Vec3f(0, 1, 0)))
         ->evaluate({&q, 1}, {&geometric, 1});
     EXPECT_GT(poisson.T_s.r, 0.0f);
     EXPECT_GT(poisson.P.r, poisson.V);

@@ -47,7 +47,7 @@ constexpr float kSlabDiameter = 5e-5f;
 /// Global-term settings of the slab tests (diameter kSlabDiameter, defaults otherwise).
 inline GlobalTermSettings slabSettings() {
     GlobalTermSettings s;
-    s.fiberDiameter = kSlabDiameter;
+    s.fiberScale.diameter = kSlabDiameter;
     return s;
 }
 

@@ -20,16 +20,16 @@ FiberGrid smallGrid(bool tensor) {
     p.strands = 200;
     SplatOptions o;
     o.storeOrientationTensor = tensor;
-    o.fiberDiameter = 7e-5f;
-    o.densityScale = 2.5f;
+    o.fiberScale.diameter = 7e-5f;
+    o.fiberScale.densityMultiplier = 2.5f;
     o.sourceFile = "curly test groom.hair";
     return splatStrands(generateGroom(p), o);
 }
 
 void expectSameInfo(const FiberGridInfo& a, const FiberGridInfo& b) {
     EXPECT_EQ(a.voxelSize, b.voxelSize);
-    EXPECT_EQ(a.fiberDiameter, b.fiberDiameter);
-    EXPECT_EQ(a.densityScale, b.densityScale);
+    EXPECT_EQ(a.fiberScale.diameter, b.fiberScale.diameter);
+    EXPECT_EQ(a.fiberScale.densityMultiplier, b.fiberScale.densityMultiplier);
     EXPECT_EQ(a.sourceFile, b.sourceFile);
     EXPECT_EQ(a.sourceHash, b.sourceHash);
     EXPECT_EQ(a.strands, b.strands);
@@ -159,9 +159,10 @@ TEST(FiberGridIo, VdbPrintListsGridsAndMetadata) {
     writeFiberGrid(dir / "grid.vdb", smallGrid(true));
     const auto [status, output] = run("vdb_print -l '" + (dir / "grid.vdb").string() + "'");
     ASSERT_EQ(status, 0) << output;
-    for (const char* expected : {"density", "orientation", "tensorDiag", "tensorOffDiag",
-                                 "voxel_size", "fiber_diameter", "density_scale", "source_file",
-                                 "source_hash", "segments", "total_length", "hairvox_version"})
+    for (const char* expected :
+         {"density", "orientation", "tensorDiag", "tensorOffDiag", "voxel_size", "fiber_diameter",
+          "density_multiplier", "source_file", "source_hash", "segments", "total_length",
+          "hairvox_version"})
         EXPECT_NE(output.find(expected), std::string::npos) << expected << " in\n" << output;
 }
 

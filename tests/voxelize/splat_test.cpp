@@ -351,13 +351,13 @@ TEST(Splat, RecordsWhatTheGridWasMadeFrom) {
     p.strands = 50;
     const Groom groom = generateGroom(p);
     SplatOptions options;
-    options.fiberDiameter = 6e-5f;
-    options.densityScale = 3.0f;
+    options.fiberScale.diameter = 6e-5f;
+    options.fiberScale.densityMultiplier = 3.0f;
     options.sourceFile = "head.hair";
     const FiberGrid g = splatStrands(groom, options);
     EXPECT_EQ(g.info.voxelSize, defaultVoxelSize(groom));
-    EXPECT_EQ(g.info.fiberDiameter, 6e-5f);
-    EXPECT_EQ(g.info.densityScale, 3.0f);
+    EXPECT_EQ(g.info.fiberScale.diameter, 6e-5f);
+    EXPECT_EQ(g.info.fiberScale.densityMultiplier, 3.0f);
     EXPECT_EQ(g.info.sourceFile, "head.hair");
     EXPECT_EQ(g.info.sourceHash, hexDigest(contentHash(groom)));
     EXPECT_EQ(g.info.strands, 50u);
@@ -408,10 +408,10 @@ TEST(Splat, RefusesInvalidOptions) {
     for (double h : {-1.0, std::nan(""), HUGE_VAL})
         EXPECT_THROW(splatStrands(groom, withVoxelSize(h)), InputError) << h;
     SplatOptions o;
-    o.fiberDiameter = 0;
+    o.fiberScale.diameter = 0;
     EXPECT_THROW(splatStrands(groom, o), InputError);
     o = SplatOptions{};
-    o.densityScale = -2;
+    o.fiberScale.densityMultiplier = -2;
     EXPECT_THROW(splatStrands(groom, o), InputError);
 }
 

@@ -27,7 +27,7 @@ TEST(VoxelizeCli, WritesAGridAndReportsIt) {
     const auto hair = writeGroom(dir);
     const auto vdb = dir / "out" / "grid.vdb";
     const auto r = test::runHairvox("voxelize " + quoted(hair) + " -o " + quoted(vdb) +
-                                    " --voxels-across 64 --diameter 6e-5 --density-scale 2"
+                                    " --voxels-across 64 --diameter 6e-5 --density-multiplier 2"
                                     " --orientation-tensor --threads 1");
     ASSERT_EQ(r.exitCode, 0) << r.output;
     for (const char* expected : {"active voxels:", "memory:", "MiB", "time:", "voxelize"})
@@ -35,8 +35,8 @@ TEST(VoxelizeCli, WritesAGridAndReportsIt) {
     const FiberGrid grid = readFiberGrid(vdb);
     const Groom groom = readGroom(hair).groom;
     EXPECT_DOUBLE_EQ(grid.info.voxelSize, defaultVoxelSize(groom, 64));
-    EXPECT_EQ(grid.info.fiberDiameter, 6e-5f);
-    EXPECT_EQ(grid.info.densityScale, 2.0f);
+    EXPECT_EQ(grid.info.fiberScale.diameter, 6e-5f);
+    EXPECT_EQ(grid.info.fiberScale.densityMultiplier, 2.0f);
     EXPECT_EQ(grid.info.sourceFile, hair.string());
     EXPECT_TRUE(grid.hasTensor());
     EXPECT_NE(r.output.find(std::to_string(grid.activeVoxelCount() % 1000)), std::string::npos);

@@ -1,5 +1,7 @@
 #include "brick_volume.h"
 
+#include <hairvox/core/grid_traversal.h>
+
 #include <glm/common.hpp>
 
 #include <algorithm>
@@ -14,7 +16,8 @@ namespace {
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
 
 std::uint32_t hashBrick(const glm::ivec3& b) {
-    return static_cast<std::uint32_t>(b.x) * 73856093u ^ static_cast<std::uint32_t>(b.y) * 19349663u ^
+    return static_cast<std::uint32_t>(b.x) * 73856093u ^
+           static_cast<std::uint32_t>(b.y) * 19349663u ^
            static_cast<std::uint32_t>(b.z) * 83492791u;
 }
 
@@ -40,36 +43,12 @@ inline void addSimpson(Lanes& a, const Lanes& f0, const Lanes& fm, const Lanes& 
         a.v[lane] += w * (f0.v[lane] + 4.0f * fm.v[lane] + f1.v[lane]);
 }
 
-/// Amanatides–Woo traversal of a grid of cubic cells `size` index units wide
-/// along O + s·dir: the current cell, and the s at which the ray leaves it
-/// through each axis' face.
-struct Dda {
-    glm::ivec3 cell, step;
-    Vec3f sNext, sDelta;
-
-    Dda(const Vec3f& O, const Vec3f& dir, const glm::ivec3& startCell, float size) : cell(startCell) {
-        for (int a = 0; a < 3; ++a) {
-            step[a] = dir[a] > 0 ? 1 : (dir[a] < 0 ? -1 : 0);
-            sDelta[a] = dir[a] != 0 ? size / std::abs(dir[a]) : kInfinity;
-            sNext[a] = dir[a] != 0
-                           ? (size * float(cell[a] + (dir[a] > 0 ? 1 : 0)) - O[a]) / dir[a]
-                           : kInfinity;
-        }
-    }
-    float exit() const { return std::min({sNext.x, sNext.y, sNext.z}); }
-    /// Steps into the next cell; returns the axis crossed.
-    int advance() {
-        const int a = sNext.x <= sNext.y ? (sNext.x <= sNext.z ? 0 : 2) : (sNext.y <= sNext.z ? 1 : 2);
-        cell[a] += step[a];
-        sNext[a] += sDelta[a];
-        return a;
-    }
-};
-
 } // namespace
 
 BrickVolume::BrickVolume(double voxelSize)
-    : h_(voxelSize), invH_(static_cast<float>(1.0 / voxelSize)), slots_(64, -1) {}
+    : h_(voxelSize)
+    , invH_(static_cast<float>(1.0 / voxelSize))
+    , slots_(64, -1) {}
 
 std::size_t BrickVolume::memoryBytes() const {
     return values_.capacity() * sizeof(Lanes) + brickCoord_.capacity() * sizeof(glm::ivec3) +
@@ -138,15 +117,16 @@ void BrickVolume::set(const BrickSet& bricks, const glm::ivec3& local, const Opt
     for (int mask = 0; mask < 8; ++mask) {
         if ((mask & onLowFace) != mask || bricks.brick[mask] < 0)
             continue;
-        const glm::ivec3 l = local + kBrick * glm::ivec3((mask >> 2) & 1, (mask >> 1) & 1, mask & 1);
+        const glm::ivec3 l =
+            local + kBrick * glm::ivec3((mask >> 2) & 1, (mask >> 1) & 1, mask & 1);
         values_[static_cast<std::size_t>(bricks.brick[mask]) * kBrickValues +
                 static_cast<std::size_t>(valueIndex(l.x, l.y, l.z))] = Lanes::from(value);
     }
 }
 
-
 template <typename F>
-void BrickVolume::walkBricks(const Vec3f& O, const Vec3f& dir, float s0, float s1, F&& visit) const {
+void BrickVolume::walkBricks(const Vec3f& O, const Vec3f& dir, float s0, float s1,
+                             F&& visit) const {
     if (empty())
         return;
     const Vec3f lo = Vec3f(kBrick * brickMin_), hi = Vec3f(kBrick * (brickMax_ + 1));
@@ -162,23 +142,13 @@ void BrickVolume::walkBricks(const Vec3f& O, const Vec3f& dir, float s0, float s
     }
     if (!(s0 < s1))
         return;
-    // Brick-level DDA (bricks are 8 index units wide).
-    const Vec3f p0 = O + s0 * dir;
-    Dda dda(O, dir, glm::clamp(glm::ivec3(glm::floor(p0 / float(kBrick))), brickMin_, brickMax_),
-            float(kBrick));
-    float s = s0;
-    for (;;) {
-        const float sExit = std::min(dda.exit(), s1);
-        if (const std::int64_t brick = find(dda.cell); brick >= 0 && sExit > s)
-            if (!visit(static_cast<std::size_t>(brick), dda.cell, s, sExit))
-                return;
-        if (sExit >= s1)
-            return;
-        s = sExit;
-        const int a = dda.advance();
-        if (dda.cell[a] < brickMin_[a] || dda.cell[a] > brickMax_[a])
-            return;
-    }
+    // Bricks are cells 8 index units wide: traverse the line scaled by 1/8.
+    const GridLine<float> inBricks(O / float(kBrick), dir / float(kBrick));
+    traverseCells(inBricks, s0, s1, brickMin_, brickMax_,
+                  [&](const glm::ivec3& b, float sEnter, float sExit) {
+                      const std::int64_t brick = find(b);
+                      return brick < 0 || visit(static_cast<std::size_t>(brick), b, sEnter, sExit);
+                  });
 }
 
 template <typename NextSplit, typename OnPiece>
@@ -187,54 +157,40 @@ void BrickVolume::forEachPiece(std::size_t brick, const glm::ivec3& b, const Vec
                                OnPiece&& onPiece) const {
     const Lanes* v = &values_[brick * kBrickValues];
     const glm::ivec3 base = kBrick * b;
-    // The cell containing the start: on a cell face, the one the ray enters.
-    const Vec3f pa = O + sa * dir;
-    glm::ivec3 start;
-    for (int a = 0; a < 3; ++a) {
-        int ci = static_cast<int>(std::floor(pa[a]));
-        if (dir[a] < 0 && static_cast<float>(ci) == pa[a])
-            --ci;
-        start[a] = std::clamp(ci, base[a], base[a] + kBrick - 1);
-    }
-    Dda dda(O, dir, start, 1.0f);
     // The field is continuous: a piece's end value is the next piece's start value.
-    float s = sa;
     Lanes fStart;
     bool haveStart = false;
-    for (;;) {
-        const float sEnd = std::min(dda.exit(), sb);
-        if (sEnd > s) {
-            const glm::ivec3 l = dda.cell - base;
-            const Lanes* corner[8];
-            bool any = false;
-            for (int k = 0; k < 8; ++k) {
-                corner[k] = &v[valueIndex(l.x + (k >> 2), l.y + ((k >> 1) & 1), l.z + (k & 1))];
-                any = any || corner[k]->v[0] != 0.0f;
-            }
-            if (any) {
-                const Vec3f cf(dda.cell);
-                const auto at = [&](float t) { return trilinear(corner, O + t * dir - cf); };
-                if (!haveStart)
-                    fStart = at(s);
-                for (float a = s; a < sEnd;) {
-                    const float e = std::min(nextSplit(a), sEnd);
-                    const Lanes fEnd = at(e);
-                    onPiece(a, e, fStart, at(0.5f * (a + e)), fEnd);
-                    fStart = fEnd;
-                    a = e;
-                }
-            } else {
-                fStart = Lanes{};
-            }
-            haveStart = true;
-        }
-        if (sEnd >= sb)
-            break;
-        s = sEnd;
-        const int a = dda.advance();
-        if (dda.cell[a] < base[a] || dda.cell[a] >= base[a] + kBrick)
-            break;
-    }
+    traverseCells(GridLine<float>(O, dir), sa, sb, base, base + (kBrick - 1),
+                  [&](const glm::ivec3& cell, float s, float sEnd) {
+                      const glm::ivec3 l = cell - base;
+                      const Lanes* corner[8];
+                      bool any = false;
+                      for (int k = 0; k < 8; ++k) {
+                          corner[k] =
+                              &v[valueIndex(l.x + (k >> 2), l.y + ((k >> 1) & 1), l.z + (k & 1))];
+                          any = any || corner[k]->v[0] != 0.0f;
+                      }
+                      if (!any) {
+                          fStart = Lanes{};
+                          haveStart = true;
+                          return true;
+                      }
+                      const Vec3f cf(cell);
+                      const auto at = [&](float t) {
+                          return trilinear(corner, O + t * dir - cf);
+                      };
+                      if (!haveStart)
+                          fStart = at(s);
+                      haveStart = true;
+                      for (float a = s; a < sEnd;) {
+                          const float e = std::min(nextSplit(a), sEnd);
+                          const Lanes fEnd = at(e);
+                          onPiece(a, e, fStart, at(0.5f * (a + e)), fEnd);
+                          fStart = fEnd;
+                          a = e;
+                      }
+                      return true;
+                  });
 }
 
 OpticalDepths BrickVolume::integrate(const Vec3f& origin, const Vec3f& dir, float tStart,

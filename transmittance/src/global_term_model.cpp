@@ -7,12 +7,7 @@
 namespace hairvox {
 
 void GlobalTermSettings::validate() const {
-    if (!(fiberDiameter > 0 && fiberDiameter < 1e3f))
-        throw InputError(strCat("fiber diameter = ", fiberDiameter,
-                                " should be in the range (0, 1000)"));
-    if (!(densityMultiplier > 0 && densityMultiplier <= 1e6f))
-        throw InputError(strCat("density multiplier = ", densityMultiplier,
-                                " should be in the range (0, 1e6]"));
+    fiberScale.validate();
     dualScattering.validate();
     if (occluder && (!isFinite(occluder->center) || !(occluder->radius > 0)))
         throw InputError("occluder sphere needs a finite centre and a radius > 0");
@@ -36,8 +31,10 @@ namespace {
 class OccludedLightGlobalTerm final : public LightGlobalTerm {
 public:
     OccludedLightGlobalTerm(std::unique_ptr<LightGlobalTerm> inner, const Sphere& occluder,
-                            const LightGeometry& light)
-        : inner_(std::move(inner)), occluder_(occluder), light_(light) {}
+                            const Light& light)
+        : inner_(std::move(inner))
+        , occluder_(occluder)
+        , light_(light) {}
 
     GlobalTermStats evaluate(std::span<const GlobalTermQuery> queries,
                              std::span<GlobalTerm> out) const override {
@@ -46,7 +43,7 @@ public:
         open.reserve(queries.size());
         openIndex.reserve(queries.size());
         for (std::size_t i = 0; i < queries.size(); ++i) {
-            const LightGeometry::Path path = light_.pathFrom(queries[i].position);
+            const Light::Path path = light_.pathFrom(queries[i].position);
             if (occluder_.intersects(queries[i].position, path.omega, path.distance)) {
                 out[i] = GlobalTerm::blocked();
             } else {
@@ -64,21 +61,21 @@ public:
     }
 
     bool blocksEverything() const override {
-        return (light_.kind == LightGeometry::Kind::Point && occluder_.contains(light_.position)) ||
+        return (light_.kind == Light::Kind::Point && occluder_.contains(light_.position)) ||
                inner_->blocksEverything();
     }
 
 private:
     std::unique_ptr<LightGlobalTerm> inner_;
     Sphere occluder_;
-    LightGeometry light_;
+    Light light_;
 };
 
 } // namespace
 
 std::unique_ptr<LightGlobalTerm> withOccluder(std::unique_ptr<LightGlobalTerm> inner,
                                               const std::optional<Sphere>& occluder,
-                                              const LightGeometry& light) {
+                                              const Light& light) {
     if (!occluder)
         return inner;
     return std::make_unique<OccludedLightGlobalTerm>(std::move(inner), *occluder, light);

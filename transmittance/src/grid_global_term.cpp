@@ -18,39 +18,14 @@
 
 namespace hairvox {
 
-using detail::OpticalDepths;
 using detail::BrickVolume;
 using detail::LightSpaceCache;
-
-const char* toString(OrientationModel model) {
-    switch (model) {
-    case OrientationModel::MeanTangent: return "mean-tangent";
-    case OrientationModel::CoherenceBlend: return "coherence-blend";
-    case OrientationModel::Tensor: return "tensor";
-    }
-    return "unknown";
-}
-
-const char* toString(GridEvaluation evaluation) {
-    switch (evaluation) {
-    case GridEvaluation::Cache: return "cache";
-    case GridEvaluation::March: return "march";
-    }
-    return "unknown";
-}
-
-const char* toString(AttenuationEstimator estimator) {
-    switch (estimator) {
-    case AttenuationEstimator::Poisson: return "poisson";
-    case AttenuationEstimator::Geometric: return "geometric";
-    }
-    return "unknown";
-}
+using detail::OpticalDepths;
 
 void GridOptions::validate(const FiberGrid& grid) const {
     if (!(startOffset >= 0 && startOffset <= 8))
-        throw InputError(strCat("grid start offset = ", startOffset,
-                                " voxels should be in the range [0, 8]"));
+        throw InputError(
+            strCat("grid start offset = ", startOffset, " voxels should be in the range [0, 8]"));
     if (!(cacheSpacing >= 0.5f && cacheSpacing <= 4))
         throw InputError(strCat("grid cache spacing = ", cacheSpacing,
                                 " voxels should be in the range [0.5, 4]"));
@@ -103,10 +78,9 @@ CrossingTable::Rates expectedRates(const VoxelFibers& v, const Vec3f& omega,
         // E[(ω·u)²] = ωᵀ T ω with T = [[xx xy xz] [xy yy yz] [xz yz zz]].
         const Vec3f& d = v.tensorDiag;
         const Vec3f& o = v.tensorOffDiag;
-        const float s2 = d.x * omega.x * omega.x + d.y * omega.y * omega.y +
-                         d.z * omega.z * omega.z +
-                         2.0f * (o.x * omega.x * omega.y + o.y * omega.x * omega.z +
-                                 o.z * omega.y * omega.z);
+        const float s2 =
+            d.x * omega.x * omega.x + d.y * omega.y * omega.y + d.z * omega.z * omega.z +
+            2.0f * (o.x * omega.x * omega.y + o.y * omega.x * omega.z + o.z * omega.y * omega.z);
         const float s = std::sqrt(std::clamp(s2, 0.0f, 1.0f));
         // The tensor has no sign: average the two inclinations ±θ.
         return (table.rates(s) + table.rates(-s)) * 0.5f;
@@ -119,13 +93,17 @@ class GridModel final : public GlobalTermModel {
 public:
     GridModel(GlobalTermMode mode, const FiberGrid& grid, const CrossingTable& crossings,
               const GlobalTermSettings& settings, const GridOptions& options)
-        : mode_(mode), grid_(grid), crossings_(crossings), settings_(settings), options_(options) {}
+        : mode_(mode)
+        , grid_(grid)
+        , crossings_(crossings)
+        , settings_(settings)
+        , options_(options) {}
 
     GlobalTermMode mode() const override { return mode_; }
-    std::unique_ptr<LightGlobalTerm> forLight(const LightGeometry& light) const override;
+    std::unique_ptr<LightGlobalTerm> forLight(const Light& light) const override;
 
     /// Per-light rates at every active voxel of the fiber grid.
-    BrickVolume buildRates(const LightGeometry& light) const;
+    BrickVolume buildRates(const Light& light) const;
 
     const CrossingTable& crossings() const { return crossings_; }
     const GlobalTermSettings& settings() const { return settings_; }
@@ -140,7 +118,7 @@ private:
     GridOptions options_;
 };
 
-BrickVolume GridModel::buildRates(const LightGeometry& light) const {
+BrickVolume GridModel::buildRates(const Light& light) const {
     using LeafT = openvdb::FloatTree::LeafNodeType;
     const double h = grid_.info.voxelSize;
     BrickVolume volume(h);
@@ -159,18 +137,21 @@ BrickVolume GridModel::buildRates(const LightGeometry& light) const {
         }
         volume.reserveBrick(brickOf(*leaf), lowFaces);
     }
-    const float kD = settings_.densityMultiplier * settings_.fiberDiameter;
+    const float kD = settings_.fiberScale.ribbonWidth();
     const bool tensor = options_.orientation == OrientationModel::Tensor;
     const bool poisson = options_.estimator == AttenuationEstimator::Poisson;
     // The orientation grids share the density's topology: read them leaf by leaf.
-    const auto vec = [](const openvdb::Vec3s& v) { return Vec3f(v.x(), v.y(), v.z()); };
+    const auto vec = [](const openvdb::Vec3s& v) {
+        return Vec3f(v.x(), v.y(), v.z());
+    };
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size(), 4), [&](const auto& range) {
         for (std::size_t li = range.begin(); li != range.end(); ++li) {
             const LeafT& leaf = *leaves[li];
             const openvdb::Coord origin = leaf.origin();
             const auto* orientation = grid_.orientation->tree().probeConstLeaf(origin);
             const auto* diag = tensor ? grid_.tensorDiag->tree().probeConstLeaf(origin) : nullptr;
-            const auto* offDiag = tensor ? grid_.tensorOffDiag->tree().probeConstLeaf(origin) : nullptr;
+            const auto* offDiag =
+                tensor ? grid_.tensorOffDiag->tree().probeConstLeaf(origin) : nullptr;
             const BrickVolume::BrickSet bricks = volume.brickSet(brickOf(leaf));
             for (auto it = leaf.cbeginValueOn(); it; ++it) {
                 const openvdb::Index i = it.pos();
@@ -194,11 +175,13 @@ BrickVolume GridModel::buildRates(const LightGeometry& light) const {
 
 class GridLightGlobalTerm final : public LightGlobalTerm {
 public:
-    GridLightGlobalTerm(const GridModel& model, const LightGeometry& light)
-        : model_(model), light_(light), rates_(model.buildRates(light)) {
+    GridLightGlobalTerm(const GridModel& model, const Light& light)
+        : model_(model)
+        , light_(light)
+        , rates_(model.buildRates(light)) {
         if (model.options().evaluation == GridEvaluation::Cache)
-            cache_ = LightSpaceCache::build(rates_, light, kOpaqueDepth,
-                                            model.options().cacheSpacing);
+            cache_ =
+                LightSpaceCache::build(rates_, light, kOpaqueDepth, model.options().cacheSpacing);
     }
 
     GlobalTermStats evaluate(std::span<const GlobalTermQuery> queries,
@@ -221,7 +204,7 @@ public:
 
 private:
     GlobalTerm evaluateOne(const GlobalTermQuery& q, bool& touched) const {
-        const LightGeometry::Path path = light_.pathFrom(q.position);
+        const Light::Path path = light_.pathFrom(q.position);
         const float start = model_.options().startOffset * static_cast<float>(model_.voxelSize());
         if (!(path.distance > start))
             return GlobalTerm::unoccluded();
@@ -246,13 +229,13 @@ private:
     }
 
     const GridModel& model_;
-    LightGeometry light_;
+    Light light_;
     BrickVolume rates_;
     /// Empty when evaluating by march, or for a point light inside the volume.
     std::optional<LightSpaceCache> cache_;
 };
 
-std::unique_ptr<LightGlobalTerm> GridModel::forLight(const LightGeometry& light) const {
+std::unique_ptr<LightGlobalTerm> GridModel::forLight(const Light& light) const {
     throwIfInterrupted();
     return withOccluder(std::make_unique<GridLightGlobalTerm>(*this, light), settings_.occluder,
                         light);
@@ -260,7 +243,8 @@ std::unique_ptr<LightGlobalTerm> GridModel::forLight(const LightGeometry& light)
 
 } // namespace
 
-std::unique_ptr<GlobalTermModel> makeGridModel(const FiberGrid& grid, const CrossingTable& crossings,
+std::unique_ptr<GlobalTermModel> makeGridModel(const FiberGrid& grid,
+                                               const CrossingTable& crossings,
                                                const GlobalTermSettings& settings,
                                                const GridOptions& options) {
     settings.validate();

@@ -22,9 +22,8 @@ std::array<Vec3f, 8> corners(const Bounds3f& b) {
 
 } // namespace
 
-std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates,
-                                                      const LightGeometry& light, float opaqueDepth,
-                                                      float spacing) {
+std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates, const Light& light,
+                                                      float opaqueDepth, float spacing) {
     LightSpaceCache cache;
     cache.h_ = static_cast<float>(rates.voxelSize());
     const Bounds3f bounds = rates.bounds();
@@ -34,7 +33,7 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates,
     const auto boxCorners = corners(bounds);
 
     float sMaxWorld = 0; // farthest lattice distance the volume reaches, world units
-    if (light.kind == LightGeometry::Kind::Directional) {
+    if (light.kind == Light::Kind::Directional) {
         cache.axis_ = -light.direction;
         coordinateSystem(cache.axis_, cache.e1_, cache.e2_);
         cache.du_ = spacing * cache.h_;

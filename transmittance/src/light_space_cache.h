@@ -15,7 +15,7 @@
 
 #include "brick_volume.h"
 
-#include <hairvox/transmittance/light_geometry.h>
+#include <hairvox/geometry/light.h>
 
 #include <cstdint>
 #include <optional>
@@ -28,8 +28,8 @@ public:
     /// Empty for a point light inside (or too close to) the volume's bounds,
     /// where a perspective lattice cannot cover it: queries then march.
     /// `spacing` is the distance between lines in voxels (along them: one voxel).
-    static std::optional<LightSpaceCache>
-    build(const BrickVolume& rates, const LightGeometry& light, float opaqueDepth, float spacing);
+    static std::optional<LightSpaceCache> build(const BrickVolume& rates, const Light& light,
+                                                float opaqueDepth, float spacing);
 
     /// The integral from p to the light.
     OpticalDepths lookup(const Vec3f& p) const;

@@ -1,8 +1,4 @@
-#include <hairvox/core/atomic_file.h>
-#include <hairvox/core/error.h>
 #include <hairvox/transmittance/lit_grid.h>
-
-#include <openvdb/io/File.h>
 
 #include <vector>
 
@@ -59,15 +55,7 @@ void writeLitGrid(const std::filesystem::path& path, const LitGrid& lit,
     for (const auto& g : grids)
         for (const auto& [key, value] : metadata)
             g->insertMeta(key, openvdb::StringMetadata(value));
-    writeFileAtomically(path, [&](const std::filesystem::path& tmp) {
-        try {
-            openvdb::io::File file(tmp.string());
-            file.write(grids);
-            file.close();
-        } catch (const openvdb::Exception& e) {
-            throw InputError(strCat(path.string(), ": cannot write: ", e.what()));
-        }
-    });
+    writeVdbFile(path, grids);
 }
 
 } // namespace hairvox

@@ -32,10 +32,9 @@ std::vector<GlobalTermQuery> sampleFiberPoints(const Groom& groom, std::size_t c
     Pcg32 rng(seed, 0x9e0b3);
     for (std::size_t k = 0; k < count; ++k) {
         const double target = rng.uniformDouble() * total;
-        const auto seg = static_cast<std::size_t>(
-            std::min<std::ptrdiff_t>(std::upper_bound(cumulative.begin(), cumulative.end(), target) -
-                                         cumulative.begin(),
-                                     static_cast<std::ptrdiff_t>(cumulative.size()) - 1));
+        const auto seg = static_cast<std::size_t>(std::min<std::ptrdiff_t>(
+            std::upper_bound(cumulative.begin(), cumulative.end(), target) - cumulative.begin(),
+            static_cast<std::ptrdiff_t>(cumulative.size()) - 1));
         const Vec3f a = groom.points[segmentStart[seg]], b = groom.points[segmentStart[seg] + 1];
         const float t = rng.uniformFloat();
         points.push_back({lerp(t, a, b), normalizeOr(b - a, Vec3f(0, 1, 0)), segmentStrand[seg]});
@@ -50,7 +49,8 @@ std::vector<std::string_view> splitCsv(std::string_view line) {
     std::size_t start = 0;
     for (;;) {
         const std::size_t comma = line.find(',', start);
-        std::string_view f = line.substr(start, comma == std::string_view::npos ? comma : comma - start);
+        std::string_view f =
+            line.substr(start, comma == std::string_view::npos ? comma : comma - start);
         while (!f.empty() && (f.front() == ' ' || f.front() == '\t'))
             f.remove_prefix(1);
         while (!f.empty() && (f.back() == ' ' || f.back() == '\t' || f.back() == '\r'))
@@ -91,8 +91,9 @@ std::vector<GlobalTermQuery> readProbePoints(const std::filesystem::path& path) 
             const std::string_view f = fields[static_cast<std::size_t>(c)];
             const auto [end, ec] = std::from_chars(f.data(), f.data() + f.size(), v[c]);
             if (ec != std::errc() || end != f.data() + f.size() || !std::isfinite(v[c]))
-                throw InputError(strCat(path.string(), ":", lineNumber, ": column ", expected[std::size_t(c)],
-                                        ": '", f, "' is not a finite number"));
+                throw InputError(strCat(path.string(), ":", lineNumber, ": column ",
+                                        expected[std::size_t(c)], ": '", f,
+                                        "' is not a finite number"));
         }
         const Vec3f tangent(v[3], v[4], v[5]);
         if (!(glm::length(tangent) > 1e-12f))
@@ -177,7 +178,7 @@ ProbeError compareGlobalTerms(std::span<const GlobalTerm> estimate,
     return e;
 }
 
-std::vector<GlobalTerm> evaluateGlobalTerm(const GlobalTermModel& model, const LightGeometry& light,
+std::vector<GlobalTerm> evaluateGlobalTerm(const GlobalTermModel& model, const Light& light,
                                            std::span<const GlobalTermQuery> points) {
     std::vector<GlobalTerm> out(points.size());
     model.forLight(light)->evaluate(points, out);

@@ -19,7 +19,7 @@ namespace {
 
 constexpr const char* kMetaVoxelSize = "voxel_size";
 constexpr const char* kMetaFiberDiameter = "fiber_diameter";
-constexpr const char* kMetaDensityScale = "density_scale";
+constexpr const char* kMetaDensityMultiplier = "density_multiplier";
 constexpr const char* kMetaSourceFile = "source_file";
 constexpr const char* kMetaSourceHash = "source_hash";
 constexpr const char* kMetaStrands = "strands";
@@ -29,8 +29,9 @@ constexpr const char* kMetaVersion = "hairvox_version";
 
 void addMetadata(openvdb::GridBase& grid, const FiberGridInfo& info) {
     grid.insertMeta(kMetaVoxelSize, openvdb::DoubleMetadata(info.voxelSize));
-    grid.insertMeta(kMetaFiberDiameter, openvdb::FloatMetadata(info.fiberDiameter));
-    grid.insertMeta(kMetaDensityScale, openvdb::FloatMetadata(info.densityScale));
+    grid.insertMeta(kMetaFiberDiameter, openvdb::FloatMetadata(info.fiberScale.diameter));
+    grid.insertMeta(kMetaDensityMultiplier,
+                    openvdb::FloatMetadata(info.fiberScale.densityMultiplier));
     grid.insertMeta(kMetaSourceFile, openvdb::StringMetadata(info.sourceFile));
     grid.insertMeta(kMetaSourceHash, openvdb::StringMetadata(info.sourceHash));
     grid.insertMeta(kMetaStrands, openvdb::Int64Metadata(static_cast<std::int64_t>(info.strands)));
@@ -54,8 +55,13 @@ T metaValue(const openvdb::GridBase& grid, const char* name, const std::string& 
 FiberGridInfo readMetadata(const openvdb::GridBase& grid, const std::string& file) {
     FiberGridInfo info;
     info.voxelSize = metaValue<double>(grid, kMetaVoxelSize, file);
-    info.fiberDiameter = metaValue<float>(grid, kMetaFiberDiameter, file);
-    info.densityScale = metaValue<float>(grid, kMetaDensityScale, file);
+    info.fiberScale.diameter = metaValue<float>(grid, kMetaFiberDiameter, file);
+    // Grids written before the density multiplier had one name call it density_scale.
+    info.fiberScale.densityMultiplier = metaValue<float>(
+        grid,
+        grid.getMetadata<openvdb::FloatMetadata>(kMetaDensityMultiplier) ? kMetaDensityMultiplier
+                                                                         : "density_scale",
+        file);
     info.sourceFile = metaValue<std::string>(grid, kMetaSourceFile, file);
     info.sourceHash = metaValue<std::string>(grid, kMetaSourceHash, file);
     const std::int64_t strands = metaValue<std::int64_t>(grid, kMetaStrands, file);
@@ -67,10 +73,12 @@ FiberGridInfo readMetadata(const openvdb::GridBase& grid, const std::string& fil
     };
     if (!(std::isfinite(info.voxelSize) && info.voxelSize > 0))
         throw bad(kMetaVoxelSize, info.voxelSize, "> 0");
-    if (!(std::isfinite(info.fiberDiameter) && info.fiberDiameter > 0))
-        throw bad(kMetaFiberDiameter, info.fiberDiameter, "> 0");
-    if (!(std::isfinite(info.densityScale) && info.densityScale > 0))
-        throw bad(kMetaDensityScale, info.densityScale, "> 0");
+    try {
+        info.fiberScale.validate();
+    } catch (const InputError& e) {
+        throw InputError(strCat(file, ": metadata ", kMetaFiberDiameter, "/",
+                                kMetaDensityMultiplier, ": ", e.what()));
+    }
     if (strands < 0)
         throw bad(kMetaStrands, strands, ">= 0");
     if (segments < 0)
@@ -134,6 +142,11 @@ void writeFiberGrid(const std::filesystem::path& path, const FiberGrid& grid) {
         addMetadata(*copy, grid.info);
         grids.push_back(copy);
     }
+    writeVdbFile(path, grids);
+}
+
+void writeVdbFile(const std::filesystem::path& path, const openvdb::GridPtrVec& grids) {
+    openvdb::initialize();
     writeFileAtomically(path, [&](const std::filesystem::path& tmp) {
         try {
             openvdb::io::File out(tmp.string());

@@ -15,6 +15,7 @@
 //     emits OpenVDB leaves. No voxel is written by two bricks: no merge step.
 //  4. The leaves are added to the trees serially (cheap: one per 512 voxels).
 #include <hairvox/core/error.h>
+#include <hairvox/core/grid_traversal.h>
 #include <hairvox/core/hash.h>
 #include <hairvox/core/interrupt.h>
 #include <hairvox/core/parallel.h>
@@ -40,7 +41,6 @@
 #include <numeric>
 #include <sstream>
 #include <unordered_map>
-
 
 namespace hairvox {
 
@@ -133,72 +133,11 @@ std::vector<StrandRange> strandChunks(const Groom& groom) {
     return chunks;
 }
 
-// ---------------------------------------------------------------------------
-// Cell traversal (Amanatides & Woo 1987, "A Fast Voxel Traversal Algorithm").
-
-/// ⌊x⌋ for |x| < 2³¹, inline (std::floor is a libm call on baseline x86-64,
-/// and this runs several times per segment).
-int floorToInt(double x) {
-    const auto i = static_cast<int>(x);
-    return x < i ? i - 1 : i;
-}
+/// A segment a + t·d, t ∈ [0, 1], in index space (core/grid_traversal.h).
+using IndexSegment = GridLine<double>;
 
 Vec3i floorToInt(const Vec3d& v) {
-    return {floorToInt(v.x), floorToInt(v.y), floorToInt(v.z)};
-}
-
-/// The segment a + t·d, t ∈ [0, 1], in index space, with 1/d per axis (0 on
-/// an axis the segment does not advance along, or too little for 1/d).
-struct IndexSegment {
-    Vec3d a, d, invD;
-
-    IndexSegment(const Vec3d& start, const Vec3d& delta)
-        : a(start)
-        , d(delta) {
-        for (int i = 0; i < 3; ++i) {
-            const double inv = 1.0 / d[i];
-            invD[i] = std::isfinite(inv) ? inv : 0.0;
-        }
-    }
-    Vec3d at(double t) const { return a + t * d; }
-};
-
-/// Calls f(cell, tEnter, tExit) for the unit cells that segment s crosses for
-/// t ∈ [t0, t1], in order, skipping pieces of zero length (Amanatides & Woo
-/// 1987). Cell c is the cube [c, c + 1]. Cells are kept in [cellMin,
-/// cellMax]: the traversal stops if rounding would step outside (the caller
-/// clipped the segment to that range, so only a rounding-sized piece is lost).
-template <typename F>
-void traverseCells(const IndexSegment& s, double t0, double t1, const Vec3i& cellMin,
-                   const Vec3i& cellMax, const F& f) {
-    Vec3i cell, step;
-    Vec3d tNext;
-    const Vec3d x0 = s.at(t0);
-    for (int i = 0; i < 3; ++i) {
-        cell[i] = std::clamp(floorToInt(x0[i]), cellMin[i], cellMax[i]);
-        step[i] = s.invD[i] > 0 ? 1 : (s.invD[i] < 0 ? -1 : 0);
-        tNext[i] = step[i] == 0 ? std::numeric_limits<double>::infinity()
-                                : (cell[i] + (step[i] > 0 ? 1 : 0) - s.a[i]) * s.invD[i];
-    }
-    double t = t0;
-    for (;;) {
-        // The axis whose boundary comes first, written to compile without branches.
-        const bool xFirst = tNext.x < tNext.y;
-        const double tXY = xFirst ? tNext.x : tNext.y;
-        const int i = tNext.z < tXY ? 2 : (xFirst ? 0 : 1);
-        const double tExit = std::min(tNext[i], t1);
-        if (tExit > t) {
-            f(cell, t, tExit);
-            t = tExit;
-        }
-        if (tExit >= t1)
-            return;
-        cell[i] += step[i];
-        if (cell[i] < cellMin[i] || cell[i] > cellMax[i])
-            return;
-        // Recomputed from the boundary, not accumulated, so no drift on long segments.
-        tNext[i] = (cell[i] + (step[i] > 0 ? 1 : 0) - s.a[i]) * s.invD[i];
-    }
+    return {hairvox::floorToInt(v.x), hairvox::floorToInt(v.y), hairvox::floorToInt(v.z)};
 }
 
 // ---------------------------------------------------------------------------
@@ -258,6 +197,7 @@ void bricksOfSegment(const Vec3d& a, const Vec3d& b, std::vector<BrickKey>& out)
                 for (int ey = 0; ey <= up.y; ++ey)
                     for (int ez = 0; ez <= up.z; ++ez)
                         add({brick.x + ex, brick.y + ey, brick.z + ez});
+            return true;
         });
 }
 
@@ -430,12 +370,12 @@ public:
         double t0 = 0, t1 = 1;
         for (int i = 0; i < 3; ++i) {
             constexpr double lo = 0, hi = kBrickSize + 1;
-            if (s.invD[i] == 0.0) {
-                if (s.a[i] < lo || s.a[i] > hi)
+            if (s.invDir[i] == 0.0) {
+                if (s.origin[i] < lo || s.origin[i] > hi)
                     return;
                 continue;
             }
-            double ta = (lo - s.a[i]) * s.invD[i], tb = (hi - s.a[i]) * s.invD[i];
+            double ta = (lo - s.origin[i]) * s.invDir[i], tb = (hi - s.origin[i]) * s.invDir[i];
             if (ta > tb)
                 std::swap(ta, tb);
             t0 = std::max(t0, ta);
@@ -454,7 +394,7 @@ public:
         Vec3i leafLo, leafHi;
         for (int i = 0; i < 3; ++i) {
             const auto cellAt = [&](double t) {
-                return std::clamp(floorToInt(s.a[i] + t * s.d[i]), 0, kBrickSize);
+                return std::clamp(hairvox::floorToInt(s.origin[i] + t * s.dir[i]), 0, kBrickSize);
             };
             const int c0 = cellAt(t0), c1 = cellAt(t1);
             leafLo[i] = (std::max(std::min(c0, c1), 1) - 1) / kLeafDim;
@@ -475,9 +415,10 @@ public:
                 if (cell[i] != previous[i])
                     f[i] = cell[i] > previous[i] ? 0.0 : 1.0;
             previous = cell;
-            const Vec3d delta = (tB - tA) * s.d;
+            const Vec3d delta = (tB - tA) * s.dir;
             splatPiece(cell, f, delta, length * (tB - tA), channel);
             f += delta;
+            return true;
         });
     }
 
@@ -785,10 +726,7 @@ void validateOptions(const SplatOptions& o) {
     if (!(std::isfinite(o.voxelSize) && o.voxelSize >= 0))
         throw InputError(strCat("voxelize: voxel size = ", o.voxelSize,
                                 " should be > 0 (or 0 for the groom's default)"));
-    if (!(std::isfinite(o.fiberDiameter) && o.fiberDiameter > 0))
-        throw InputError(strCat("voxelize: fiber diameter = ", o.fiberDiameter, " should be > 0"));
-    if (!(std::isfinite(o.densityScale) && o.densityScale > 0))
-        throw InputError(strCat("voxelize: density scale = ", o.densityScale, " should be > 0"));
+    o.fiberScale.validate();
 }
 
 /// Refuses, before anything is allocated, a voxel size that the groom's
@@ -875,8 +813,7 @@ FiberGrid splatStrands(const Groom& groom, const SplatOptions& options) {
 
     FiberGrid grid;
     grid.info.voxelSize = h;
-    grid.info.fiberDiameter = options.fiberDiameter;
-    grid.info.densityScale = options.densityScale;
+    grid.info.fiberScale = options.fiberScale;
     grid.info.sourceFile = options.sourceFile;
     grid.info.sourceHash = hexDigest(hash);
     grid.info.strands = groom.strandCount();
@@ -929,8 +866,7 @@ std::uint64_t FiberGrid::memoryBytes() const {
 }
 
 std::ostream& operator<<(std::ostream& os, const FiberGridInfo& info) {
-    return os << "FiberGridInfo(voxelSize=" << info.voxelSize
-              << ", fiberDiameter=" << info.fiberDiameter << ", densityScale=" << info.densityScale
+    return os << "FiberGridInfo(voxelSize=" << info.voxelSize << ", " << info.fiberScale
               << ", sourceFile=\"" << info.sourceFile << "\", sourceHash=" << info.sourceHash
               << ", strands=" << info.strands << ", segments=" << info.segments
               << ", totalLength=" << info.totalLength << ", version=" << info.version << ")";
@@ -942,8 +878,7 @@ std::ostream& operator<<(std::ostream& os, const FiberGrid& grid) {
 }
 
 std::ostream& operator<<(std::ostream& os, const SplatOptions& o) {
-    return os << "SplatOptions(voxelSize=" << o.voxelSize << ", fiberDiameter=" << o.fiberDiameter
-              << ", densityScale=" << o.densityScale
+    return os << "SplatOptions(voxelSize=" << o.voxelSize << ", " << o.fiberScale
               << ", storeOrientationTensor=" << o.storeOrientationTensor
               << ", threaded=" << o.threaded << ", memoryBudgetBytes=" << o.memoryBudgetBytes
               << ", sourceFile=\"" << o.sourceFile << "\", showProgress=" << o.showProgress << ")";

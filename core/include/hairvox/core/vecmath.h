@@ -76,20 +76,34 @@ struct Sphere {
     Vec3f center{0.0f};
     float radius = 0;
 
-    bool contains(const Vec3f& p) const { return glm::dot(p - center, p - center) < radius * radius; }
+    bool contains(const Vec3f& p) const {
+        return glm::dot(p - center, p - center) < radius * radius;
+    }
 
-    /// Whether the segment o + t·d, t ∈ (0, tMax), meets the sphere; d unit.
-    bool intersects(const Vec3f& o, const Vec3f& d, float tMax) const {
+    /// The first t ∈ (0, tMax) at which the ray o + t·d (d unit) meets the
+    /// sphere's surface, or a negative value if it does not. A ray starting
+    /// inside meets it on the way out. The one ray–sphere intersection of the
+    /// project (the head's occlusion, its primary visibility and the path
+    /// tracer all call it).
+    float intersect(const Vec3f& o, const Vec3f& d, float tMax) const {
         const Vec3f oc = o - center;
         const float b = glm::dot(oc, d);
         const float c = glm::dot(oc, oc) - radius * radius;
-        if (c < 0)
-            return true; // starts inside
         const float disc = b * b - c;
-        if (disc < 0 || b > 0)
-            return false; // misses, or points away
-        const float t0 = -b - std::sqrt(disc);
-        return t0 < tMax;
+        if (disc < 0)
+            return -1.0f;
+        const float root = std::sqrt(disc);
+        // Of the two roots −b ∓ √disc, the nearer one in front of the origin;
+        // c = (−b − √disc)(−b + √disc) gives the near root without cancellation.
+        const float far = -b + root;
+        const float near = far > 0 ? c / far : -b - root;
+        const float t = near > 0 ? near : far;
+        return t > 0 && t < tMax ? t : -1.0f;
+    }
+    /// Whether the segment o + t·d, t ∈ (0, tMax), meets the sphere (a segment
+    /// starting inside does).
+    bool intersects(const Vec3f& o, const Vec3f& d, float tMax) const {
+        return contains(o) || intersect(o, d, tMax) > 0;
     }
 };
 

@@ -1,14 +1,17 @@
-// hairvox render: the interface between the rasterizer and the shading.
+// hairvox render: the interface between the rasterizer and whatever shades
+// the hair it finds.
 //
 // Shading is deferred: the rasterizer finds which points of which strands are
 // visible in which pixels, then hands them to a FragmentShader in batches (so
-// that the per-light global term can be evaluated for many points at once) and
-// composites the answers. The shader returns, per point, the reflected
-// radiance summed over the scene's lights as the components of the dual-
-// scattering model (shading/global_term.h ShadeResult: single scattering per
-// lobe, f_back^direct, F_scatter — each already multiplied by cos θ_i, its
-// visibility weight and the light's irradiance), plus the global term toward
-// each light, which the film keeps as AOVs.
+// that an expensive per-point term — the dual-scattering global term — can be
+// evaluated for many points at once) and composites the answers. A shader
+// returns, per point, a fixed number of floats whose meaning its ShaderLayout
+// declares:
+//  - radiance layers (RGB): radiance toward the camera, composited with the
+//    fragment's weight (premultiplied by coverage) and added to the beauty;
+//  - average layers (1 or 3 channels): any per-point quantity (visibility,
+//    optical depth, ...) that the film keeps as the weighted mean over the
+//    visible hair in the pixel (not premultiplied; 0 where there is no hair).
 //
 // Shading rate:
 //  - fragment: every visible fragment is shaded at the point of its segment
@@ -20,52 +23,68 @@
 // the segment, so the two differ only in where the shader is evaluated.
 #pragma once
 
-#include <hairvox/core/rgb.h>
+#include <hairvox/core/enum_names.h>
 #include <hairvox/core/vecmath.h>
-#include <hairvox/shading/global_term.h>
 
 #include <cstdint>
-#include <optional>
 #include <ostream>
 #include <span>
-#include <string_view>
+#include <string>
+#include <vector>
 
 namespace hairvox {
 
 enum class ShadingRate { Fragment, Vertex };
 
-const char* toString(ShadingRate rate);
-std::optional<ShadingRate> parseShadingRate(std::string_view name);
-inline std::ostream& operator<<(std::ostream& os, ShadingRate r) { return os << toString(r); }
+inline constexpr EnumNames<ShadingRate, 2> kShadingRateNames{{{
+    {ShadingRate::Fragment, "fragment"},
+    {ShadingRate::Vertex, "vertex"},
+}}};
+inline const char* toString(ShadingRate rate) {
+    return kShadingRateNames.name(rate);
+}
+inline std::ostream& operator<<(std::ostream& os, ShadingRate r) {
+    return os << toString(r);
+}
 
 /// A visible point on a fiber's centreline, in world space.
 struct ShadingPoint {
     Vec3f position;
-    Vec3f tangent;          ///< unit fiber tangent u, root → tip
-    Vec3f toCamera;         ///< unit ω_o, from the point toward the camera
-    std::uint32_t strand;   ///< index of the strand in the groom
-    std::uint32_t segment;  ///< point index of the root-side vertex of the segment holding the point
+    Vec3f tangent;         ///< unit fiber tangent u, root → tip
+    Vec3f toCamera;        ///< unit ω_o, from the point toward the camera
+    std::uint32_t strand;  ///< index of the strand in the groom
+    std::uint32_t segment; ///< point index of the root-side vertex of the segment holding the point
 };
 
 std::ostream& operator<<(std::ostream& os, const ShadingPoint& p);
+
+/// What a shader returns per point: radiance layers first (3 floats each),
+/// then average layers (AverageLayer::channels floats each).
+struct ShaderLayout {
+    struct AverageLayer {
+        std::string name;
+        int channels = 1; ///< 1 or 3
+    };
+    std::vector<std::string> radiance; ///< RGB layer names, e.g. "direct_R"
+    std::vector<AverageLayer> averages;
+
+    std::size_t radianceFloats() const { return 3 * radiance.size(); }
+    /// Floats per shaded point.
+    std::size_t stride() const;
+};
 
 class FragmentShader {
 public:
     virtual ~FragmentShader() = default;
 
-    /// Shades a batch. `radiance[i]` receives the radiance reflected toward
-    /// the camera at points[i], summed over the lights; `globalTerms` holds
-    /// points.size() × L entries (L = the scene's light count), the global
-    /// term at points[i] toward light l at index i·L + l (L = 0: empty).
-    /// Results must depend only on the point (not on the batch), be finite
-    /// and non-negative; the film rejects anything else and reports it.
-    /// Called concurrently from several threads.
-    virtual void shade(std::span<const ShadingPoint> points, std::span<ShadeResult> radiance,
-                       std::span<GlobalTerm> globalTerms) const = 0;
-};
+    virtual const ShaderLayout& layout() const = 0;
 
-/// sum += weight ⊙ s, component by component (a light's irradiance, a pixel weight).
-void addWeighted(ShadeResult& sum, const ShadeResult& s, const Rgb& weight);
-void addWeighted(ShadeResult& sum, const ShadeResult& s, float weight);
+    /// Shades a batch: out[i·stride .. (i + 1)·stride) for points[i], laid out
+    /// as layout() says. Results must depend only on the point (not on the
+    /// batch); radiance must be finite and non-negative, averages finite — the
+    /// rasterizer rejects anything else and reports it. Called concurrently
+    /// from several threads.
+    virtual void shade(std::span<const ShadingPoint> points, std::span<float> out) const = 0;
+};
 
 } // namespace hairvox

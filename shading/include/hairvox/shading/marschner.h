@@ -29,6 +29,7 @@
 #include <hairvox/core/rgb.h>
 #include <hairvox/core/vecmath.h>
 #include <hairvox/shading/fiber_params.h>
+#include <hairvox/shading/longitudinal.h>
 
 #include <array>
 #include <memory>
@@ -117,8 +118,8 @@ private:
 
     FiberParams params_;
     std::array<float, 3> alpha_{}, beta_{};
-    std::array<float, 3> invTwoBeta2_{}, mScale_{}; ///< 1/(2β²), ½/(β√2π)
-    std::shared_ptr<const AzimuthalTable> table_;   ///< shared: copies are cheap
+    std::array<LongitudinalLobe, 3> M_;           ///< M_p (longitudinal.h)
+    std::shared_ptr<const AzimuthalTable> table_; ///< shared: copies are cheap
 };
 
 std::ostream& operator<<(std::ostream& os, const MarschnerBcsdf& b);

@@ -9,6 +9,7 @@
 // crash, a hang or a huge allocation — and then runs sanitizeGroom().
 #pragma once
 
+#include <hairvox/core/enum_names.h>
 #include <hairvox/strands/groom.h>
 
 #include <cstdint>
@@ -20,7 +21,14 @@ namespace hairvox {
 
 enum class GroomFormat { Hair, Tfx, Obj };
 
-const char* toString(GroomFormat format);
+inline constexpr EnumNames<GroomFormat, 3> kGroomFormatNames{{{
+    {GroomFormat::Hair, "hair"},
+    {GroomFormat::Tfx, "tfx"},
+    {GroomFormat::Obj, "obj"},
+}}};
+inline const char* toString(GroomFormat format) {
+    return kGroomFormatNames.name(format);
+}
 
 struct GroomReadOptions {
     /// Refuse files that would hold more points than this (memory guard for

@@ -15,6 +15,7 @@
 // Units are metres; y is up and the face looks towards +z.
 #pragma once
 
+#include <hairvox/core/enum_names.h>
 #include <hairvox/strands/groom.h>
 
 #include <cstdint>
@@ -26,9 +27,17 @@ namespace hairvox {
 
 enum class GroomStyle { Straight, Wavy, Curly };
 
-const char* toString(GroomStyle style);
-std::optional<GroomStyle> parseGroomStyle(std::string_view name);
-inline std::ostream& operator<<(std::ostream& os, GroomStyle style) { return os << toString(style); }
+inline constexpr EnumNames<GroomStyle, 3> kGroomStyleNames{{{
+    {GroomStyle::Straight, "straight"},
+    {GroomStyle::Wavy, "wavy"},
+    {GroomStyle::Curly, "curly"},
+}}};
+inline const char* toString(GroomStyle style) {
+    return kGroomStyleNames.name(style);
+}
+inline std::ostream& operator<<(std::ostream& os, GroomStyle style) {
+    return os << toString(style);
+}
 
 struct ProceduralGroomParams {
     GroomStyle style = GroomStyle::Wavy;

@@ -3,9 +3,9 @@
 // between the modes through this one setting.
 #pragma once
 
-#include <optional>
+#include <hairvox/core/enum_names.h>
+
 #include <ostream>
-#include <string_view>
 
 namespace hairvox {
 
@@ -15,9 +15,15 @@ enum class GlobalTermMode {
     Approx, ///< n from the grid, every crossed fiber sharing the shading point's orientation
 };
 
-const char* toString(GlobalTermMode mode);
-std::optional<GlobalTermMode> parseGlobalTermMode(std::string_view name);
+inline constexpr EnumNames<GlobalTermMode, 3> kGlobalTermModeNames{{{
+    {GlobalTermMode::Exact, "exact"},
+    {GlobalTermMode::Grid, "grid"},
+    {GlobalTermMode::Approx, "approx"},
+}}};
 
+inline const char* toString(GlobalTermMode mode) {
+    return kGlobalTermModeNames.name(mode);
+}
 inline std::ostream& operator<<(std::ostream& os, GlobalTermMode mode) {
     return os << toString(mode);
 }

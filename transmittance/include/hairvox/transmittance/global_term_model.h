@@ -9,11 +9,12 @@
 #pragma once
 
 #include <hairvox/core/vecmath.h>
+#include <hairvox/geometry/light.h>
+#include <hairvox/geometry/ray_scene.h>
 #include <hairvox/shading/fiber_params.h>
 #include <hairvox/shading/global_term.h>
 #include <hairvox/transmittance/crossing_table.h>
 #include <hairvox/transmittance/global_term_mode.h>
-#include <hairvox/transmittance/light_geometry.h>
 
 #include <cstdint>
 #include <memory>
@@ -21,8 +22,6 @@
 #include <span>
 
 namespace hairvox {
-
-inline constexpr std::uint32_t kUnknownStrand = UINT32_MAX;
 
 /// A point on a fiber and that fiber's unit tangent (root → tip). The strand
 /// index, when the caller knows it, saves the exact mode a search for the
@@ -63,8 +62,7 @@ public:
 
 /// Inputs every mode shares.
 struct GlobalTermSettings {
-    float fiberDiameter = 8e-5f;    ///< D, world units
-    float densityMultiplier = 1.0f; ///< one modeled strand stands for k real hairs
+    FiberScale fiberScale; ///< D and k: optical depth λ·k·D·cos θ, ribbons k·D wide
     DualScatteringParams dualScattering;
     std::optional<Sphere> occluder; ///< the opaque head: blocks light entirely
 
@@ -75,7 +73,7 @@ class GlobalTermModel {
 public:
     virtual ~GlobalTermModel() = default;
     virtual GlobalTermMode mode() const = 0;
-    virtual std::unique_ptr<LightGlobalTerm> forLight(const LightGeometry& light) const = 0;
+    virtual std::unique_ptr<LightGlobalTerm> forLight(const Light& light) const = 0;
 };
 
 /// The global term from the expected optical depths along a shadow path under
@@ -92,6 +90,6 @@ GlobalTerm globalTermFromDepths(float n, const Rgb& tauP, const Rgb& sumBeta2, f
 /// Returns `inner` unchanged when there is no occluder.
 std::unique_ptr<LightGlobalTerm> withOccluder(std::unique_ptr<LightGlobalTerm> inner,
                                               const std::optional<Sphere>& occluder,
-                                              const LightGeometry& light);
+                                              const Light& light);
 
 } // namespace hairvox

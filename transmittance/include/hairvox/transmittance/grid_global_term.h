@@ -38,6 +38,7 @@
 // P from n·(1 − ā_f(θ_x)) (or ā_f(θ_x)^n), Σβ² = n·β̄_f²(θ_x).
 #pragma once
 
+#include <hairvox/core/enum_names.h>
 #include <hairvox/transmittance/global_term_model.h>
 
 #include <memory>
@@ -51,17 +52,30 @@ struct FiberGrid;
 enum class OrientationModel {
     MeanTangent,    ///< w at the normalised mean tangent o/|o| (DESIGN.md's simplest estimate)
     CoherenceBlend, ///< |o|·w(o/|o|) + (1 − |o|)·(isotropic average of w)
-    Tensor,         ///< w at |sin θ| = sqrt(ωᵀ E[uuᵀ] ω), symmetrised (needs the tensor grids)
+    Tensor, ///< w at |sin θ| = sqrt(ωᵀ E[uuᵀ] ω), symmetrised (needs the tensor grids)
 };
 
 /// The estimator of E[P] = E[∏ ā_f(θ_k)] under Poisson-distributed crossings.
 enum class AttenuationEstimator {
-    Poisson,   ///< exp(−∫ λkD E[cos θ (1 − ā_f)] ds): the mean of ∏ā_f over crossings
+    Poisson, ///< exp(−∫ λkD E[cos θ (1 − ā_f)] ds): the mean of ∏ā_f over crossings
     Geometric, ///< exp(∫ λkD E[cos θ ln ā_f] ds): the paper's ā_f^n (a geometric mean; biased low)
 };
 
-const char* toString(OrientationModel model);
-const char* toString(AttenuationEstimator estimator);
+inline constexpr EnumNames<OrientationModel, 3> kOrientationModelNames{{{
+    {OrientationModel::MeanTangent, "mean-tangent"},
+    {OrientationModel::CoherenceBlend, "coherence-blend"},
+    {OrientationModel::Tensor, "tensor"},
+}}};
+inline constexpr EnumNames<AttenuationEstimator, 2> kAttenuationEstimatorNames{{{
+    {AttenuationEstimator::Poisson, "poisson"},
+    {AttenuationEstimator::Geometric, "geometric"},
+}}};
+inline const char* toString(OrientationModel m) {
+    return kOrientationModelNames.name(m);
+}
+inline const char* toString(AttenuationEstimator e) {
+    return kAttenuationEstimatorNames.name(e);
+}
 
 /// How a LightGlobalTerm of the grid modes evaluates its queries.
 enum class GridEvaluation {
@@ -69,13 +83,19 @@ enum class GridEvaluation {
     March, ///< one exact march per query
 };
 
-const char* toString(GridEvaluation evaluation);
+inline constexpr EnumNames<GridEvaluation, 2> kGridEvaluationNames{{{
+    {GridEvaluation::Cache, "cache"},
+    {GridEvaluation::March, "march"},
+}}};
+inline const char* toString(GridEvaluation e) {
+    return kGridEvaluationNames.name(e);
+}
 
 struct GridOptions {
     OrientationModel orientation = OrientationModel::CoherenceBlend;
     AttenuationEstimator estimator = AttenuationEstimator::Poisson;
     GridEvaluation evaluation = GridEvaluation::Cache;
-    float startOffset = 0.0f; ///< voxels toward the light before integrating, [0, 8]
+    float startOffset = 0.0f;  ///< voxels toward the light before integrating, [0, 8]
     float cacheSpacing = 1.5f; ///< voxels between the cache's shadow lines, [0.5, 4]
 
     void validate(const FiberGrid& grid) const;
@@ -85,7 +105,8 @@ std::ostream& operator<<(std::ostream& os, const GridOptions& options);
 
 /// The `grid` mode. The model keeps a reference to `grid`, which must outlive it
 /// and every LightGlobalTerm it returns.
-std::unique_ptr<GlobalTermModel> makeGridModel(const FiberGrid& grid, const CrossingTable& crossings,
+std::unique_ptr<GlobalTermModel> makeGridModel(const FiberGrid& grid,
+                                               const CrossingTable& crossings,
                                                const GlobalTermSettings& settings,
                                                const GridOptions& options);
 

@@ -43,7 +43,7 @@ ProbeError compareGlobalTerms(std::span<const GlobalTerm> estimate,
                               std::span<const GlobalTerm> reference);
 
 /// Evaluates one light for all points (a convenience for probes and tests).
-std::vector<GlobalTerm> evaluateGlobalTerm(const GlobalTermModel& model, const LightGeometry& light,
+std::vector<GlobalTerm> evaluateGlobalTerm(const GlobalTermModel& model, const Light& light,
                                            std::span<const GlobalTermQuery> points);
 
 } // namespace hairvox

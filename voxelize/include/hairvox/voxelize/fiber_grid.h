@@ -46,10 +46,12 @@
 //   i.e. interpolate λ·o (or λ·T) rather than λ and o separately.
 //
 // Voxels are active where λ is at least FLT_MIN; elsewhere every grid reads
-// its background 0. fiberDiameter D and densityScale k are recorded for the
-// consumers (optical depth λ·k·D·|ω×u|); λ itself counts modeled strands only.
+// its background 0. The fiber scale (diameter D, density multiplier k;
+// strands/fiber_scale.h) is recorded for the consumers (optical depth
+// λ·k·D·|ω×u|); λ itself counts modeled strands only.
 #pragma once
 
+#include <hairvox/strands/fiber_scale.h>
 #include <hairvox/strands/groom.h>
 
 #include <openvdb/openvdb.h>
@@ -69,15 +71,13 @@ inline constexpr const char* kTensorDiagGridName = "tensorDiag";
 inline constexpr const char* kTensorOffDiagGridName = "tensorOffDiag";
 
 /// What a fiber grid was made from; stored as metadata on every grid of a .vdb
-/// (names in fiber_grid_io.cpp: voxel_size, fiber_diameter, density_scale,
+/// (names in fiber_grid_io.cpp: voxel_size, fiber_diameter, density_multiplier,
 /// source_file, source_hash, strands, segments, total_length, hairvox_version).
 struct FiberGridInfo {
-    double voxelSize = 0; ///< h, world units (metres for the procedural grooms)
-    float fiberDiameter =
-        8e-5f; ///< D, world units (metadata for consumers; λ does not depend on it)
-    float densityScale = 1.0f; ///< one modeled strand stands for k real hairs (metadata)
-    std::string sourceFile;    ///< as given to splatStrands (the CLI passes the input path)
-    std::string sourceHash;    ///< hexDigest(contentHash(groom))
+    double voxelSize = 0;   ///< h, world units (metres for the procedural grooms)
+    FiberScale fiberScale;  ///< D and k, for the consumers (λ does not depend on them)
+    std::string sourceFile; ///< as given to splatStrands (the CLI passes the input path)
+    std::string sourceHash; ///< hexDigest(contentHash(groom))
     std::uint64_t strands = 0, segments = 0;
     double totalLength = 0; ///< Σ segment lengths of the groom, world units
     std::string version;    ///< hairvox version that splatted the grid
@@ -122,9 +122,8 @@ inline constexpr int kDefaultVoxelsAcross = 256;
 double defaultVoxelSize(const Groom& groom, int voxelsAcross = kDefaultVoxelsAcross);
 
 struct SplatOptions {
-    double voxelSize = 0;        ///< h > 0; 0 = defaultVoxelSize(groom)
-    float fiberDiameter = 8e-5f; ///< D > 0, recorded in FiberGridInfo
-    float densityScale = 1.0f;   ///< k > 0, recorded in FiberGridInfo
+    double voxelSize = 0;  ///< h > 0; 0 = defaultVoxelSize(groom)
+    FiberScale fiberScale; ///< recorded in FiberGridInfo
     /// Also splat E[u uᵀ] (two more Vec3S grids, ~2.5× the memory); off until
     /// the transmittance stage measures that it pays.
     bool storeOrientationTensor = false;
@@ -148,6 +147,10 @@ FiberGrid splatStrands(const Groom& groom, const SplatOptions& options);
 
 /// Writes the grids with their metadata as one .vdb file, atomically.
 void writeFiberGrid(const std::filesystem::path& path, const FiberGrid& grid);
+
+/// Writes OpenVDB grids as one .vdb file through writeFileAtomically() (every
+/// .vdb hairvox writes goes through here); InputError naming the path on failure.
+void writeVdbFile(const std::filesystem::path& path, const openvdb::GridPtrVec& grids);
 
 /// Reads a .vdb written by writeFiberGrid. Throws InputError naming the file if
 /// it is unreadable, lacks the density or orientation grid or the hairvox

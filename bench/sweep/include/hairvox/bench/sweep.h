@@ -1,0 +1,208 @@
+// hairvox bench: the benchmark sweep — run time against error, and how cost
+// grows (docs/DESIGN.md §6 "Runtime against error"; `hairvox bench`).
+//
+// The sweep is a program over the pipeline's public API, split by job:
+// job.h (a job and its files, worker processes), measure.h (running one job:
+// timings and errors), report.h (CSV and Markdown), plots.h (matplotlib).
+//
+// Accuracy sweep. For each scene: global-term mode (exact, grid, approx) ×
+// voxel size × shading rate. Each configuration is rendered end to end with
+// renderScene() (outputs written to a scratch directory, so the `write` stage
+// is real) `runs` times (once if the first run exceeds `singleRunAbove`);
+// every stage time is the median over the runs and the total is the median of
+// the totals. It is compared with the scene's
+// reference, an exact-mode render of the same scene and camera:
+//  - image: relative L1 = Σ|I − I_ref| / Σ|I_ref| and relative RMSE =
+//    sqrt(mean (I − I_ref)²) / mean I_ref of the beauty RGB over hair pixels
+//    (the reference's Film::hairAlpha > 0);
+//  - probe: MAE of V and T_s (transmittance/probe.h) at `probePoints` points on
+//    the fibers, toward every light, against exact mode with `probeRays` rays
+//    spread over a disk of radius = the configuration's voxel size (the
+//    footprint a voxel resolves). The head is left out of the probe: points it
+//    shadows are GlobalTerm::blocked() in every mode and would only dilute it.
+// The image reference uses `referenceRays` rays per shading point (exact mode
+// costs K Embree rays per point: 1–16 is affordable per frame, 256 is not)
+// spread over a disk of one default voxel h0, the scene's grid voxel size
+// (its grid.voxel_size, else defaultVoxelSize(groom)). Exact configurations of
+// the sweep use the same footprint with fewer rays; their error is the noise
+// of K rays. Voxel sizes are given as multiples of h0.
+//
+// Scaling sweep: grid mode at the default voxel size, fragment shading, over
+// scenes of increasing segment count and increasing image size, with the
+// growth rate of each stage's time and of peak memory as the least-squares
+// exponent k of  cost ∝ size^k  (fitPowerLaw).
+//
+// Isolation: with a worker command (the CLI passes `hairvox bench --one`),
+// every job runs in its own child process, so its peak resident memory is
+// that job's alone; without one (tests) jobs run in this process and peak
+// memory is not reported. The exact reference is rendered once per scene and
+// cached in the output directory's .work/ for the run (removed at the end).
+//
+// Outputs in SweepOptions::outDir, rewritten after each scene:
+//   results.csv            one row per measured configuration (kBenchCsvColumns)
+//   results.md             the tables: summary, per scene, scaling with exponents
+//   scaling_fits.csv       the fitted growth exponents
+//   runtime_vs_error.png   total time against image error, one curve (the
+//                          Pareto front) per scene, points labelled (matplotlib)
+//   scaling.png            time against segment count and against pixel count
+#pragma once
+
+#include <hairvox/core/enum_names.h>
+#include <hairvox/film/image_compare.h>
+#include <hairvox/pipeline/pipeline.h>
+#include <hairvox/pipeline/scene.h>
+#include <hairvox/strands/procedural.h>
+#include <hairvox/transmittance/probe.h>
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <ostream>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace hairvox {
+
+/// A scene of the sweep: a scene file, or the embedded default scene (with its
+/// procedural groom's style swapped when `style` is set), then overrides.
+struct BenchScene {
+    std::string label;               ///< names the scene in tables and plots
+    std::filesystem::path file;      ///< scene JSON; empty: defaultScene()
+    std::optional<GroomStyle> style; ///< default scene only: replaces the groom's style
+    std::uint32_t strands = 0;       ///< procedural grooms: strand count; 0: the scene's
+    /// Procedural grooms: points per strand; 0: the scene's, or the style's
+    /// default when `style` swaps it.
+    std::uint32_t pointsPerStrand = 0;
+    std::uint32_t width = 0, height = 0; ///< resolution; 0: the scene's
+
+    /// The scene with the overrides applied, validated; writes no outputs.
+    Scene build() const;
+};
+
+/// One point of the accuracy sweep.
+struct BenchConfig {
+    GlobalTermMode mode = GlobalTermMode::Grid;
+    /// Grid and approx: voxel size in units of h0; exact: footprint radius in units of h0.
+    double voxelScale = 1;
+    std::uint32_t rays = 1; ///< exact: rays per shading point
+    ShadingRate shadingRate = ShadingRate::Fragment;
+
+    /// "grid x1.4", "exact K=4".
+    std::string label() const;
+};
+
+/// y ≈ coefficient · x^exponent by least squares on (ln x, ln y).
+struct PowerLawFit {
+    double exponent = 0;
+    double coefficient = 0;
+    double r2 = 0; ///< coefficient of determination in log space
+};
+
+/// Uses the pairs with x > 0 and y > 0; nullopt with fewer than two distinct x.
+std::optional<PowerLawFit> fitPowerLaw(std::span<const double> x, std::span<const double> y);
+
+/// What was measured for one configuration.
+struct BenchMeasurement {
+    StageTimes times;        ///< per-stage medians over the runs
+    double totalSeconds = 0; ///< median of the end-to-end totals
+    int runs = 0;
+    std::optional<double> peakMiB; ///< peak resident memory of the job's own process
+    std::uint64_t segments = 0, shadingPoints = 0, activeVoxels = 0;
+    double voxelSize = 0;        ///< grid voxel size, or the exact mode's footprint radius
+    double defaultVoxelSize = 0; ///< h0
+    std::optional<ImageError> image;
+    std::optional<ProbeError> probe;
+};
+
+enum class BenchSweepKind {
+    Reference, ///< the scene's exact reference render (one run)
+    Accuracy,  ///< a configuration of the accuracy sweep
+    Segments,  ///< scaling with segment count
+    Pixels,    ///< scaling with image size
+};
+
+inline constexpr EnumNames<BenchSweepKind, 4> kBenchSweepKindNames{{{
+    {BenchSweepKind::Reference, "reference"},
+    {BenchSweepKind::Accuracy, "accuracy"},
+    {BenchSweepKind::Segments, "segments"},
+    {BenchSweepKind::Pixels, "pixels"},
+}}};
+inline const char* toString(BenchSweepKind kind) {
+    return kBenchSweepKindNames.name(kind);
+}
+
+struct BenchRow {
+    BenchSweepKind kind = BenchSweepKind::Accuracy;
+    std::string scene; ///< BenchScene::label
+    BenchConfig config;
+    std::uint32_t width = 0, height = 0;
+    BenchMeasurement m;
+};
+
+/// Least-squares growth exponents of a scaling sweep (nullopt where not fitted).
+struct ScalingFit {
+    BenchSweepKind kind = BenchSweepKind::Segments;
+    std::optional<PowerLawFit> total, voxelize, globalTerm, rasterShade, peakMemory;
+};
+
+inline constexpr std::array<const char*, 26> kBenchCsvColumns = {
+    "sweep",        "scene",    "mode",           "voxel_scale",   "voxel_size", "rays",
+    "shading_rate", "width",    "height",         "segments",      "runs",       "load_s",
+    "voxelize_s",   "tables_s", "global_term_s",  "raster_s",      "shade_s",    "write_s",
+    "total_s",      "peak_mib", "shading_points", "active_voxels", "rel_l1",     "rel_rmse",
+    "mae_v",        "mae_ts"};
+
+struct SweepOptions {
+    std::vector<BenchScene> scenes;       ///< the accuracy sweep
+    std::vector<double> voxelScales;      ///< grid and approx voxel sizes, × h0
+    std::vector<std::uint32_t> exactRays; ///< exact configurations: rays per point
+    std::uint32_t referenceRays = 16;     ///< the image reference's rays per point, [1, 65536]
+    std::vector<ShadingRate> shadingRates{ShadingRate::Fragment, ShadingRate::Vertex};
+    std::size_t probePoints = 1000; ///< 0: no probe errors
+    std::uint32_t probeRays = 256;
+    std::uint64_t probeSeed = 1;
+    std::vector<BenchScene> segmentScaling; ///< scenes of increasing segment count
+    std::vector<BenchScene> pixelScaling;   ///< scenes of increasing image size
+    int runs = 3;                           ///< timed renders per configuration, [1, 100]
+    /// A configuration whose first run takes longer (seconds) is run once: the
+    /// exact configurations cost minutes and vary little. 0: always `runs`.
+    double singleRunAbove = 60;
+    int threads = 0; ///< 0: all cores
+    std::filesystem::path outDir = "bench";
+    /// Runs each job as `workerCommand... JOB.json` in a child process (the
+    /// CLI: its own executable, "bench", "--one"); empty: in this process.
+    std::vector<std::string> workerCommand;
+    std::string commandLine;     ///< recorded in results.md
+    std::ostream* log = nullptr; ///< one line per job
+
+    /// Everything: the straight, wavy (the default scene) and curly grooms
+    /// (1024²), Ratboy_mohawk (`ratboyScene`, 960²) and the 50,000-strand ×
+    /// 29-point wavy head (1.4M segments, 1920×1080); five voxel sizes; exact
+    /// with 1 and 4 rays against 16; scaling 10k–1.4M segments at 1920×1080
+    /// and 256²–2048².
+    static SweepOptions full(const std::filesystem::path& ratboyScene);
+    /// A representative subset in under 15 minutes on 2 cores: wavy and curly
+    /// at 512², voxel sizes ×4, ×2, ×1, exact with 1 ray against 4, fragment
+    /// shading, one run per configuration; scaling 10k–400k segments at
+    /// 960×540 and 256²–1024².
+    static SweepOptions quick();
+
+    void validate() const;
+};
+
+struct SweepResult {
+    std::vector<BenchRow> rows;
+    std::vector<ScalingFit> fits;
+    std::vector<std::filesystem::path> written;
+};
+
+/// Runs the sweep and writes its outputs (see the file comment).
+SweepResult runSweep(const SweepOptions& options);
+
+/// The worker side (`hairvox bench --one JOB.json`): runs the job a sweep wrote
+/// and writes its result file next to it.
+void runBenchJobFile(const std::filesystem::path& jobFile);
+
+} // namespace hairvox

@@ -1,0 +1,148 @@
+#!/usr/bin/python3
+"""Plots of a `hairvox bench` sweep, drawn with matplotlib.
+
+    plot_sweep.py OUT_DIR
+
+reads OUT_DIR/results.csv (one row per measured configuration) and
+OUT_DIR/scaling_fits.csv (the least-squares growth fits the sweep computed),
+and writes
+
+    OUT_DIR/runtime_vs_error.png   end-to-end time against image error, per scene,
+                                   with each scene's Pareto front
+    OUT_DIR/scaling.png            stage times against segment count and image size,
+                                   with the fitted power laws
+
+The benchmark (bench/sweep) calls it after writing the CSV files; it can be
+rerun by hand on a results directory. Only reads the CSVs: every number is the
+sweep's.
+"""
+import csv
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+MARKERS = {"exact": "o", "grid": "s", "approx": "^"}
+STAGES = [("total", "total_s"), ("voxelize", "voxelize_s"), ("global term", "global_term_s"),
+          ("raster+shade", None)]
+
+
+def number(row, key):
+    value = row.get(key, "")
+    return float(value) if value not in ("", None) else None
+
+
+def read_csv(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def pareto(points):
+    front = []
+    for t, e in sorted(points):
+        if not front or e < front[-1][1]:
+            front.append((t, e))
+    return front
+
+
+def short_label(row):
+    if row["mode"] == "exact":
+        return "e" + row["rays"]
+    return ("g" if row["mode"] == "grid" else "a") + "%g" % float(row["voxel_scale"])
+
+
+def plot_runtime_vs_error(rows, path):
+    accuracy = [r for r in rows if r["sweep"] == "accuracy" and number(r, "rel_l1")]
+    if not accuracy:
+        return False
+    fig, ax = plt.subplots(figsize=(11, 6.5), dpi=120)
+    scenes = list(dict.fromkeys(r["scene"] for r in accuracy))
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for i, scene in enumerate(scenes):
+        colour = colours[i % len(colours)]
+        points = []
+        for r in (r for r in accuracy if r["scene"] == scene):
+            t, e = number(r, "total_s"), number(r, "rel_l1")
+            filled = r["shading_rate"] == "fragment"
+            ax.scatter([t], [e], marker=MARKERS.get(r["mode"], "o"), s=42,
+                       facecolors=colour if filled else "none", edgecolors=colour, zorder=3)
+            ax.annotate(short_label(r), (t, e), textcoords="offset points", xytext=(4, 3),
+                        fontsize=7, color=colour)
+            points.append((t, e))
+        front = pareto(points)
+        ax.plot([p[0] for p in front], [p[1] for p in front], color=colour, lw=1.2, label=scene)
+    reference = next((r for r in rows if r["sweep"] == "reference"), None)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("end-to-end time, s")
+    ax.set_ylabel("relative L1 error of the beauty over hair pixels"
+                  + (" vs exact K=%s" % reference["rays"] if reference else ""))
+    ax.set_title("hairvox: run time against image error")
+    ax.grid(True, which="both", color="#e4e4e4", lw=0.6)
+    legend = [plt.Line2D([], [], ls="", marker=m, color="gray", label=f"{k}")
+              for k, m in MARKERS.items()]
+    first = ax.legend(loc="upper right", fontsize=8, title="scene (line: Pareto front)")
+    ax.add_artist(first)
+    ax.legend(handles=legend + [plt.Line2D([], [], ls="", marker="o", mfc="none", color="gray",
+                                           label="hollow: vertex shading")],
+              loc="lower left", fontsize=8, title="eK: K rays; gS/aS: voxel S·h0")
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+    return True
+
+
+def plot_scaling(rows, fits, path):
+    kinds = [k for k in ("segments", "pixels") if any(r["sweep"] == k for r in rows)]
+    if not kinds:
+        return False
+    fig, axes = plt.subplots(1, len(kinds), figsize=(7 * len(kinds), 5.2), dpi=120, squeeze=False)
+    for ax, kind in zip(axes[0], kinds):
+        series = [r for r in rows if r["sweep"] == kind]
+        x = [number(r, "segments") if kind == "segments"
+             else number(r, "width") * number(r, "height") for r in series]
+        for name, column in STAGES:
+            y = [number(r, column) if column else number(r, "raster_s") + number(r, "shade_s")
+                 for r in series]
+            fit = next((f for f in fits if f["kind"] == kind and f["stage"] == name), None)
+            label = name + (" k=%.2f" % float(fit["exponent"]) if fit else "")
+            points = ax.plot(x, y, "o", ms=5, label=label)[0]
+            if fit:
+                lo, hi = min(x), max(x)
+                c, k = float(fit["coefficient"]), float(fit["exponent"])
+                ax.plot([lo, hi], [c * lo ** k, c * hi ** k], color=points.get_color(), lw=1)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("segments" if kind == "segments" else "pixels")
+        ax.set_ylabel("seconds")
+        ax.set_title("time against " + ("segment count" if kind == "segments" else "image size"))
+        ax.grid(True, which="both", color="#e4e4e4", lw=0.6)
+        ax.legend(fontsize=8, title="lines: cost = c·size^k")
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+    return True
+
+
+def main():
+    if len(sys.argv) != 2:
+        sys.exit("usage: plot_sweep.py OUT_DIR")
+    out = sys.argv[1]
+    rows = read_csv(os.path.join(out, "results.csv"))
+    fits_path = os.path.join(out, "scaling_fits.csv")
+    fits = read_csv(fits_path) if os.path.exists(fits_path) else []
+    # Written under temporary names and renamed: a plot is never half-written.
+    for name, draw in (("runtime_vs_error.png", lambda p: plot_runtime_vs_error(rows, p)),
+                       ("scaling.png", lambda p: plot_scaling(rows, fits, p))):
+        final = os.path.join(out, name)
+        tmp = os.path.join(out, "." + name + ".tmp.png")
+        if draw(tmp):
+            os.replace(tmp, final)
+            print(final)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,320 @@
+#include "job.h"
+
+#include <hairvox/core/atomic_file.h>
+#include <hairvox/core/error.h>
+#include <hairvox/core/interrupt.h>
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <spawn.h>
+#include <sys/wait.h>
+
+extern char** environ;
+
+namespace hairvox::bench {
+
+using nlohmann::json;
+
+namespace {
+
+// Binary working files (references shared between job processes):
+//
+// "HVXBENCH", u64 header count, u64 float count, u64 header[], f32 data[]
+// (native byte order: written and read by the same executable on one machine).
+
+constexpr char kFloatFileMagic[8] = {'H', 'V', 'X', 'B', 'E', 'N', 'C', 'H'};
+
+struct FloatFile {
+    std::vector<std::uint64_t> header;
+    std::vector<float> data;
+};
+
+void writeFloatFile(const std::filesystem::path& path, const FloatFile& file) {
+    writeFileAtomically(path, [&](const std::filesystem::path& tmp) {
+        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+        const std::uint64_t counts[2] = {file.header.size(), file.data.size()};
+        out.write(kFloatFileMagic, sizeof(kFloatFileMagic));
+        out.write(reinterpret_cast<const char*>(counts), sizeof(counts));
+        out.write(reinterpret_cast<const char*>(file.header.data()),
+                  static_cast<std::streamsize>(file.header.size() * sizeof(std::uint64_t)));
+        out.write(reinterpret_cast<const char*>(file.data.data()),
+                  static_cast<std::streamsize>(file.data.size() * sizeof(float)));
+        if (!out)
+            throw InputError(strCat(path.string(), ": cannot write"));
+    });
+}
+
+FloatFile readFloatFile(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    char magic[8] = {};
+    std::uint64_t counts[2] = {0, 0};
+    in.read(magic, sizeof(magic));
+    in.read(reinterpret_cast<char*>(counts), sizeof(counts));
+    std::error_code ec;
+    const std::uint64_t size = std::filesystem::file_size(path, ec);
+    if (!in || ec || std::memcmp(magic, kFloatFileMagic, sizeof(magic)) != 0 || counts[0] > 64 ||
+        size != sizeof(magic) + sizeof(counts) + counts[0] * 8 + counts[1] * 4)
+        throw InputError(strCat(path.string(), ": not a benchmark working file of this version"));
+    FloatFile file;
+    file.header.resize(counts[0]);
+    file.data.resize(counts[1]);
+    in.read(reinterpret_cast<char*>(file.header.data()),
+            static_cast<std::streamsize>(file.header.size() * sizeof(std::uint64_t)));
+    in.read(reinterpret_cast<char*>(file.data.data()),
+            static_cast<std::streamsize>(file.data.size() * sizeof(float)));
+    if (!in)
+        throw InputError(strCat(path.string(), ": truncated"));
+    return file;
+}
+
+constexpr std::size_t kTermFloats = 11; // n, V, P, T_s, σ_f²
+
+json sceneToJson(const BenchScene& s) {
+    return {{"label", s.label},
+            {"file", s.file.string()},
+            {"style", s.style ? json(toString(*s.style)) : json(nullptr)},
+            {"strands", s.strands},
+            {"points_per_strand", s.pointsPerStrand},
+            {"width", s.width},
+            {"height", s.height}};
+}
+
+BenchScene sceneFromJson(const json& j) {
+    BenchScene s;
+    s.label = j.at("label").get<std::string>();
+    s.file = j.at("file").get<std::string>();
+    if (!j.at("style").is_null())
+        s.style = kGroomStyleNames.parse(j.at("style").get<std::string>());
+    s.strands = j.at("strands").get<std::uint32_t>();
+    s.pointsPerStrand = j.at("points_per_strand").get<std::uint32_t>();
+    s.width = j.at("width").get<std::uint32_t>();
+    s.height = j.at("height").get<std::uint32_t>();
+    return s;
+}
+
+json optionalJson(const std::optional<double>& v) {
+    return v ? json(*v) : json(nullptr);
+}
+
+std::optional<double> optionalFromJson(const json& j) {
+    return j.is_null() ? std::nullopt : std::optional<double>(j.get<double>());
+}
+
+} // namespace
+
+void writeBeautyImage(const std::filesystem::path& path, const BeautyImage& image) {
+    FloatFile file;
+    file.header = {std::uint64_t(image.width), std::uint64_t(image.height)};
+    file.data.reserve(image.beauty.size() * 4);
+    for (const Rgb& c : image.beauty)
+        file.data.insert(file.data.end(), {c.r, c.g, c.b});
+    file.data.insert(file.data.end(), image.mask.begin(), image.mask.end());
+    writeFloatFile(path, file);
+}
+
+BeautyImage readBeautyImage(const std::filesystem::path& path) {
+    const FloatFile file = readFloatFile(path);
+    if (file.header.size() != 2 || file.header[0] * file.header[1] * 4 != file.data.size())
+        throw InputError(strCat(path.string(), ": not a reference image"));
+    BeautyImage image;
+    image.width = static_cast<int>(file.header[0]);
+    image.height = static_cast<int>(file.header[1]);
+    const std::size_t n = file.data.size() / 4;
+    image.beauty.resize(n);
+    for (std::size_t p = 0; p < n; ++p)
+        image.beauty[p] = Rgb(file.data[3 * p], file.data[3 * p + 1], file.data[3 * p + 2]);
+    image.mask.assign(file.data.begin() + std::ptrdiff_t(3 * n), file.data.end());
+    return image;
+}
+
+void writeProbeTerms(const std::filesystem::path& path,
+                     const std::vector<std::vector<GlobalTerm>>& terms) {
+    FloatFile file;
+    file.header = {terms.size(), terms.empty() ? 0 : terms.front().size()};
+    for (const auto& light : terms)
+        for (const GlobalTerm& g : light)
+            file.data.insert(file.data.end(), {g.n, g.V, g.P.r, g.P.g, g.P.b, g.T_s.r, g.T_s.g,
+                                               g.T_s.b, g.sigma2_f.r, g.sigma2_f.g, g.sigma2_f.b});
+    writeFloatFile(path, file);
+}
+
+std::vector<std::vector<GlobalTerm>> readProbeTerms(const std::filesystem::path& path) {
+    const FloatFile file = readFloatFile(path);
+    if (file.header.size() != 2 ||
+        file.header[0] * file.header[1] * kTermFloats != file.data.size())
+        throw InputError(strCat(path.string(), ": not a probe reference"));
+    std::vector<std::vector<GlobalTerm>> terms(file.header[0],
+                                               std::vector<GlobalTerm>(file.header[1]));
+    const float* f = file.data.data();
+    for (auto& light : terms)
+        for (GlobalTerm& g : light) {
+            g = {f[0], f[1], Rgb(f[2], f[3], f[4]), Rgb(f[5], f[6], f[7]), Rgb(f[8], f[9], f[10])};
+            f += kTermFloats;
+        }
+    return terms;
+}
+
+json jobToJson(const BenchJob& job) {
+    json probeFiles = json::array();
+    for (const auto& p : job.probeFiles)
+        probeFiles.push_back(p.string());
+    return {{"reference", job.reference},
+            {"scene", sceneToJson(job.scene)},
+            {"mode", toString(job.config.mode)},
+            {"voxel_scale", job.config.voxelScale},
+            {"rays", job.config.rays},
+            {"shading_rate", toString(job.config.shadingRate)},
+            {"voxel_size", job.voxelSize},
+            {"runs", job.runs},
+            {"single_run_above", job.singleRunAbove},
+            {"threads", job.threads},
+            {"isolated", job.isolated},
+            {"scratch", job.scratch.string()},
+            {"reference_image", job.referenceImage.string()},
+            {"probe_points", job.probePoints},
+            {"probe_seed", job.probeSeed},
+            {"probe_rays", job.probeRays},
+            {"probe_scales", job.probeScales},
+            {"probe_files", probeFiles},
+            {"result", job.result.string()}};
+}
+
+BenchJob jobFromJson(const json& j) {
+    BenchJob job;
+    job.reference = j.at("reference").get<bool>();
+    job.scene = sceneFromJson(j.at("scene"));
+    job.config.mode = kGlobalTermModeNames.parse(j.at("mode").get<std::string>()).value();
+    job.config.voxelScale = j.at("voxel_scale").get<double>();
+    job.config.rays = j.at("rays").get<std::uint32_t>();
+    job.config.shadingRate =
+        kShadingRateNames.parse(j.at("shading_rate").get<std::string>()).value();
+    job.voxelSize = j.at("voxel_size").get<double>();
+    job.runs = j.at("runs").get<int>();
+    job.singleRunAbove = j.at("single_run_above").get<double>();
+    job.threads = j.at("threads").get<int>();
+    job.isolated = j.at("isolated").get<bool>();
+    job.scratch = j.at("scratch").get<std::string>();
+    job.referenceImage = j.at("reference_image").get<std::string>();
+    job.probePoints = j.at("probe_points").get<std::size_t>();
+    job.probeSeed = j.at("probe_seed").get<std::uint64_t>();
+    job.probeRays = j.at("probe_rays").get<std::uint32_t>();
+    job.probeScales = j.at("probe_scales").get<std::vector<double>>();
+    for (const auto& p : j.at("probe_files"))
+        job.probeFiles.emplace_back(p.get<std::string>());
+    job.result = j.at("result").get<std::string>();
+    return job;
+}
+
+json measurementToJson(const BenchMeasurement& m) {
+    const StageTimes& t = m.times;
+    json j = {{"times",
+               {{"load", t.load},
+                {"voxelize", t.voxelize},
+                {"tables", t.tables},
+                {"global_term", t.globalTerm},
+                {"raster", t.raster},
+                {"shade", t.shade},
+                {"write", t.write}}},
+              {"total", m.totalSeconds},
+              {"runs", m.runs},
+              {"peak_mib", optionalJson(m.peakMiB)},
+              {"segments", m.segments},
+              {"shading_points", m.shadingPoints},
+              {"active_voxels", m.activeVoxels},
+              {"voxel_size", m.voxelSize},
+              {"default_voxel_size", m.defaultVoxelSize},
+              {"image", nullptr},
+              {"probe", nullptr}};
+    if (m.image)
+        j["image"] = {{"rel_l1", m.image->relL1},
+                      {"rel_rmse", m.image->relRmse},
+                      {"pixels", m.image->pixels}};
+    if (m.probe)
+        j["probe"] = {{"mae_v", m.probe->maeV},
+                      {"mae_ts", m.probe->maeT_s},
+                      {"bias_n", m.probe->biasN},
+                      {"mean_n_ref", m.probe->meanNRef}};
+    return j;
+}
+
+BenchMeasurement measurementFromJson(const json& j) {
+    BenchMeasurement m;
+    const json& t = j.at("times");
+    m.times.load = t.at("load").get<double>();
+    m.times.voxelize = t.at("voxelize").get<double>();
+    m.times.tables = t.at("tables").get<double>();
+    m.times.globalTerm = t.at("global_term").get<double>();
+    m.times.raster = t.at("raster").get<double>();
+    m.times.shade = t.at("shade").get<double>();
+    m.times.write = t.at("write").get<double>();
+    m.totalSeconds = j.at("total").get<double>();
+    m.runs = j.at("runs").get<int>();
+    m.peakMiB = optionalFromJson(j.at("peak_mib"));
+    m.segments = j.at("segments").get<std::uint64_t>();
+    m.shadingPoints = j.at("shading_points").get<std::uint64_t>();
+    m.activeVoxels = j.at("active_voxels").get<std::uint64_t>();
+    m.voxelSize = j.at("voxel_size").get<double>();
+    m.defaultVoxelSize = j.at("default_voxel_size").get<double>();
+    if (const json& i = j.at("image"); !i.is_null())
+        m.image = ImageError{i.at("rel_l1").get<double>(), i.at("rel_rmse").get<double>(),
+                             i.at("pixels").get<std::size_t>()};
+    if (const json& p = j.at("probe"); !p.is_null())
+        m.probe = ProbeError{p.at("mae_v").get<double>(), p.at("mae_ts").get<double>(),
+                             p.at("bias_n").get<double>(), p.at("mean_n_ref").get<double>()};
+    return m;
+}
+
+void writeJsonFile(const std::filesystem::path& path, const json& j) {
+    writeFileAtomically(path, [&](const std::filesystem::path& tmp) {
+        std::ofstream out(tmp, std::ios::trunc);
+        out << j.dump(1) << "\n";
+        if (!out)
+            throw InputError(strCat(path.string(), ": cannot write"));
+    });
+}
+
+json readJsonFile(const std::filesystem::path& path) {
+    std::ifstream in(path);
+    if (!in)
+        throw InputError(strCat(path.string(), ": cannot open"));
+    try {
+        return json::parse(in);
+    } catch (const json::exception& e) {
+        throw InputError(strCat(path.string(), ": ", e.what()));
+    }
+}
+
+/// Runs `command... jobFile` and waits for it.
+void runWorker(const std::vector<std::string>& command, const std::filesystem::path& jobFile) {
+    std::vector<std::string> args = command;
+    args.push_back(jobFile.string());
+    std::vector<char*> argv;
+    for (std::string& a : args)
+        argv.push_back(a.data());
+    argv.push_back(nullptr);
+    pid_t pid = 0;
+    const int rc = posix_spawn(&pid, argv[0], nullptr, nullptr, argv.data(), environ);
+    if (rc != 0)
+        throw InputError(
+            strCat("cannot start the benchmark worker ", args[0], ": ", std::strerror(rc)));
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0)
+        if (errno != EINTR)
+            throw std::runtime_error(strCat("waitpid: ", std::strerror(errno)));
+    const bool interrupted = (WIFSIGNALED(status) && WTERMSIG(status) == SIGINT) ||
+                             (WIFEXITED(status) && WEXITSTATUS(status) == 130);
+    if (interrupted)
+        throw Interrupted();
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 0)
+        return;
+    const std::string how = WIFEXITED(status) ? strCat("exit code ", WEXITSTATUS(status))
+                                              : strCat("signal ", WTERMSIG(status));
+    const std::string message =
+        strCat("benchmark job ", jobFile.string(), " failed (", how, "; its message is above)");
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 2)
+        throw InputError(message);
+    throw std::runtime_error(message);
+}
+
+} // namespace hairvox::bench

@@ -1,0 +1,378 @@
+#include "report.h"
+
+#include "text.h"
+
+#include <hairvox/core/error.h>
+#include <hairvox/core/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <ctime>
+#include <fstream>
+#include <functional>
+#include <thread>
+
+namespace hairvox::bench {
+
+namespace {
+
+std::string cpuModel() {
+    std::ifstream in("/proc/cpuinfo");
+    std::string line;
+    while (std::getline(in, line))
+        if (line.rfind("model name", 0) == 0) {
+            const std::size_t colon = line.find(':');
+            if (colon != std::string::npos)
+                return line.substr(line.find_first_not_of(' ', colon + 1));
+        }
+    return "unknown CPU";
+}
+
+std::string utcNow() {
+    const std::time_t now = std::time(nullptr);
+    std::tm tm{};
+    gmtime_r(&now, &tm);
+    char buf[64];
+    std::strftime(buf, sizeof(buf), "%Y-%m-%d %H:%M UTC", &tm);
+    return buf;
+}
+
+std::string csvNumber(double v) {
+    return format("%.6g", v);
+}
+std::string csvOptional(const std::optional<double>& v) {
+    return v ? csvNumber(*v) : "";
+}
+
+std::string mdOptional(const std::optional<double>& v, int digits) {
+    return v ? format("%.*f", digits, *v) : "–";
+}
+
+std::string imageSize(const BenchRow& r) {
+    return strCat(r.width, "×", r.height);
+}
+
+const BenchRow* findRow(const std::vector<BenchRow>& rows, const std::string& scene,
+                        const std::function<bool(const BenchRow&)>& pred) {
+    for (const BenchRow& r : rows)
+        if (r.scene == scene && pred(r))
+            return &r;
+    return nullptr;
+}
+
+std::vector<std::string> sceneOrder(const std::vector<BenchRow>& rows, BenchSweepKind kind) {
+    std::vector<std::string> order;
+    for (const BenchRow& r : rows)
+        if (r.kind == kind && std::find(order.begin(), order.end(), r.scene) == order.end())
+            order.push_back(r.scene);
+    return order;
+}
+
+const char* stageHeader() {
+    return "| total s | load | voxelize | tables | global term | raster | shade | write | peak MiB "
+           "|";
+}
+
+std::string stageCells(const BenchMeasurement& m) {
+    const StageTimes& t = m.times;
+    return strCat(" ", seconds(m.totalSeconds), " | ", seconds(t.load), " | ", seconds(t.voxelize),
+                  " | ", seconds(t.tables), " | ", seconds(t.globalTerm), " | ", seconds(t.raster),
+                  " | ", seconds(t.shade), " | ", seconds(t.write), " | ", mdOptional(m.peakMiB, 0),
+                  " |");
+}
+
+std::string fitText(const char* what, const std::optional<PowerLawFit>& f) {
+    if (!f)
+        return strCat(what, " –");
+    return strCat(what, " k = ", format("%.2f", f->exponent), " (R² ", format("%.3f", f->r2), ")");
+}
+
+} // namespace
+
+RunInfo RunInfo::now() {
+    RunInfo info;
+    info.started = utcNow();
+    info.cpu = cpuModel();
+    info.cores = std::thread::hardware_concurrency();
+    info.loadStart = info.loadMax = loadAverage();
+    return info;
+}
+
+double loadAverage() {
+    double load[3] = {0, 0, 0};
+    return getloadavg(load, 3) >= 1 ? load[0] : 0.0;
+}
+
+std::string csvText(const std::vector<BenchRow>& rows) {
+    std::string out;
+    for (std::size_t i = 0; i < kBenchCsvColumns.size(); ++i)
+        out += std::string(i ? "," : "") + kBenchCsvColumns[i];
+    out += "\n";
+    for (const BenchRow& r : rows) {
+        const BenchMeasurement& m = r.m;
+        const StageTimes& t = m.times;
+        const std::vector<std::string> cells = {
+            toString(r.kind),
+            r.scene,
+            toString(r.config.mode),
+            csvNumber(r.config.voxelScale),
+            csvNumber(m.voxelSize),
+            r.config.mode == GlobalTermMode::Exact ? std::to_string(r.config.rays) : "",
+            toString(r.config.shadingRate),
+            std::to_string(r.width),
+            std::to_string(r.height),
+            std::to_string(m.segments),
+            std::to_string(m.runs),
+            csvNumber(t.load),
+            csvNumber(t.voxelize),
+            csvNumber(t.tables),
+            csvNumber(t.globalTerm),
+            csvNumber(t.raster),
+            csvNumber(t.shade),
+            csvNumber(t.write),
+            csvNumber(m.totalSeconds),
+            csvOptional(m.peakMiB),
+            std::to_string(m.shadingPoints),
+            std::to_string(m.activeVoxels),
+            csvOptional(m.image ? std::optional(m.image->relL1) : std::nullopt),
+            csvOptional(m.image ? std::optional(m.image->relRmse) : std::nullopt),
+            csvOptional(m.probe ? std::optional(m.probe->maeV) : std::nullopt),
+            csvOptional(m.probe ? std::optional(m.probe->maeT_s) : std::nullopt)};
+        for (std::size_t i = 0; i < cells.size(); ++i) {
+            // Scene labels are the only free text: quote them if they need it.
+            const bool quote = cells[i].find_first_of(",\"\n") != std::string::npos;
+            std::string cell = cells[i];
+            if (quote) {
+                std::string escaped;
+                for (char c : cell)
+                    escaped += c == '"' ? std::string("\"\"") : std::string(1, c);
+                cell = "\"" + escaped + "\"";
+            }
+            out += (i ? "," : "") + cell;
+        }
+        out += "\n";
+    }
+    return out;
+}
+
+/// Fixed-point with `digits` decimals, "–" when there is no value.
+std::string configText(const BenchRow& r) {
+    if (r.kind == BenchSweepKind::Reference)
+        return strCat("exact K=", r.config.rays, " (reference)");
+    return r.config.label();
+}
+
+std::string markdownText(const SweepOptions& o, const SweepResult& result, const RunInfo& info) {
+    const std::vector<BenchRow>& rows = result.rows;
+    std::string md = "# hairvox benchmark: run time against error, and how cost grows\n\n";
+    md += strCat(
+        "Generated by `", o.commandLine.empty() ? std::string("hairvox bench") : o.commandLine,
+        "`, started ", info.started, ", on ", info.cpu, " (", info.cores,
+        " hardware threads), load average (1 min) ", format("%.1f", info.loadStart),
+        " at the start, at most ", format("%.1f", info.loadMax), ", ", format("%.1f", info.loadEnd),
+        " at the end (the machine may be shared: times are wall clock).\n\n");
+    md += strCat("Times are seconds, end to end through `renderScene()` including writing the EXR "
+                 "and PNG; each stage is the median of ",
+                 o.runs, o.runs == 1 ? " run" : " runs",
+                 " and `total` the median of the totals (the exact reference: one run",
+                 o.singleRunAbove > 0 && o.runs > 1
+                     ? strCat("; a configuration whose first run takes over ",
+                              format("%g", o.singleRunAbove), " s: one run")
+                     : std::string(),
+                 "). "
+                 "Peak MiB is the resident peak of a process that ran that configuration alone. "
+                 "Errors are against an exact-mode render with K rays per shading point spread "
+                 "over a disk of one default voxel h0 (the scene's grid voxel size): relative L1 "
+                 "and relative RMSE of the beauty over hair pixels; MAE(V) and MAE(T_s) at ",
+                 o.probePoints, " points on the fibers toward each light, against exact mode with ",
+                 o.probeRays,
+                 " rays over a disk of the configuration's voxel size. `grid xS`/`approx xS`: "
+                 "voxel size S·h0; `exact K=n`: n rays over the h0 disk. The image reference "
+                 "is itself noisy (a few rays per shading point): its estimated share of the "
+                 "rel L1, from the error of the exact configuration with the fewest rays "
+                 "assuming variance ∝ 1/K, is the summary's last column — image errors near "
+                 "it are at the reference's noise floor.\n\n");
+
+    const std::vector<std::string> scenes = sceneOrder(rows, BenchSweepKind::Reference);
+    if (!scenes.empty()) {
+        const ShadingRate rate = o.shadingRates.front();
+        const std::uint32_t fewestRays =
+            o.exactRays.empty() ? 0 : *std::min_element(o.exactRays.begin(), o.exactRays.end());
+        md += strCat("## Summary (", toString(rate), " shading)\n\n");
+        md += strCat("| scene | segments | image | h0 | exact reference s | exact K=", fewestRays,
+                     " s | grid x1 s | grid speed-up: global term, total | grid x1 rel L1 | "
+                     "MAE(V) | MAE(T_s) | approx within grid's time | its rel L1 | reference "
+                     "noise (est.) |\n");
+        md += "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|\n";
+        for (const std::string& s : scenes) {
+            const BenchRow* ref = findRow(
+                rows, s, [](const BenchRow& r) { return r.kind == BenchSweepKind::Reference; });
+            const auto accuracy = [&](const BenchRow& r) {
+                return r.kind == BenchSweepKind::Accuracy && r.config.shadingRate == rate;
+            };
+            const BenchRow* exact = findRow(rows, s, [&](const BenchRow& r) {
+                return accuracy(r) && r.config.mode == GlobalTermMode::Exact &&
+                       r.config.rays == fewestRays;
+            });
+            const BenchRow* grid = findRow(rows, s, [&](const BenchRow& r) {
+                return accuracy(r) && r.config.mode == GlobalTermMode::Grid &&
+                       r.config.voxelScale == 1.0;
+            });
+            std::string line = strCat("| ", s, " | ", ref ? thousands(ref->m.segments) : "–", " | ",
+                                      ref ? imageSize(*ref) : "–", " | ",
+                                      ref ? format("%.3g", ref->m.defaultVoxelSize) : "–", " | ",
+                                      ref ? seconds(ref->m.totalSeconds) : "–", " | ",
+                                      exact ? seconds(exact->m.totalSeconds) : "–", " | ",
+                                      grid ? seconds(grid->m.totalSeconds) : "–", " | ");
+            if (grid && exact && grid->m.times.globalTerm > 0 && grid->m.totalSeconds > 0)
+                line +=
+                    strCat(format("%.1f×", exact->m.times.globalTerm / grid->m.times.globalTerm),
+                           ", ", format("%.1f×", exact->m.totalSeconds / grid->m.totalSeconds));
+            else
+                line += "–";
+            const auto relL1 = [](const BenchRow* r) {
+                return r && r->m.image ? std::optional(r->m.image->relL1) : std::nullopt;
+            };
+            line += strCat(
+                " | ", mdOptional(relL1(grid), 4), " | ",
+                mdOptional(
+                    grid && grid->m.probe ? std::optional(grid->m.probe->maeV) : std::nullopt, 4),
+                " | ",
+                mdOptional(
+                    grid && grid->m.probe ? std::optional(grid->m.probe->maeT_s) : std::nullopt, 4),
+                " | ");
+            // Approx at the grid's time budget: the most accurate approx
+            // configuration no slower than grid x1 (else the fastest one).
+            const BenchRow* approx = nullptr;
+            bool withinBudget = false;
+            for (const BenchRow& r : rows) {
+                if (r.scene != s || !accuracy(r) || r.config.mode != GlobalTermMode::Approx ||
+                    !r.m.image)
+                    continue;
+                const bool within = grid && r.m.totalSeconds <= grid->m.totalSeconds;
+                if (within && (!withinBudget || r.m.image->relL1 < approx->m.image->relL1)) {
+                    approx = &r;
+                    withinBudget = true;
+                } else if (!withinBudget &&
+                           (!approx || r.m.totalSeconds < approx->m.totalSeconds)) {
+                    approx = &r;
+                }
+            }
+            line += approx ? strCat(approx->config.label(), " (", seconds(approx->m.totalSeconds),
+                                    " s", withinBudget ? "" : ", none was as fast", ")")
+                           : std::string("–");
+            // The reference's own noise, from the error of exact K=a against it:
+            // with independent rays, variance ∝ 1/K, so err² ≈ σ²(1/a + 1/K_ref)
+            // and the reference's share is err·sqrt(a / (a + K_ref)).
+            const std::optional<double> noise =
+                relL1(exact)
+                    ? std::optional(*relL1(exact) * std::sqrt(double(fewestRays) /
+                                                              double(fewestRays + o.referenceRays)))
+                    : std::nullopt;
+            line +=
+                strCat(" | ", mdOptional(relL1(approx), 4), " | ", mdOptional(noise, 4), " |\n");
+            md += line;
+        }
+        md += "\n";
+    }
+
+    for (const std::string& s : scenes) {
+        const BenchRow* ref =
+            findRow(rows, s, [](const BenchRow& r) { return r.kind == BenchSweepKind::Reference; });
+        md += strCat("## ", s, "\n\n");
+        if (ref)
+            md += strCat(thousands(ref->m.segments), " segments, ", imageSize(*ref),
+                         ", h0 = ", format("%.4g", ref->m.defaultVoxelSize), "\n\n");
+        md += strCat("| configuration | voxel or radius | shading ", stageHeader(),
+                     " rel L1 | rel RMSE | MAE(V) | MAE(T_s) |\n");
+        md += "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+        for (const BenchRow& r : rows) {
+            if (r.scene != s ||
+                (r.kind != BenchSweepKind::Reference && r.kind != BenchSweepKind::Accuracy))
+                continue;
+            const BenchMeasurement& m = r.m;
+            md += strCat(
+                "| ", configText(r), " | ", format("%.3g", m.voxelSize), " | ",
+                toString(r.config.shadingRate), " |", stageCells(m), " ",
+                mdOptional(m.image ? std::optional(m.image->relL1) : std::nullopt, 4), " | ",
+                mdOptional(m.image ? std::optional(m.image->relRmse) : std::nullopt, 4), " | ",
+                mdOptional(m.probe ? std::optional(m.probe->maeV) : std::nullopt, 4), " | ",
+                mdOptional(m.probe ? std::optional(m.probe->maeT_s) : std::nullopt, 4), " |\n");
+        }
+        md += "\n";
+    }
+
+    for (const ScalingFit& fit : result.fits) {
+        const bool segments = fit.kind == BenchSweepKind::Segments;
+        md += strCat("## Scaling with ", segments ? "segment count" : "image size",
+                     " (grid mode, default voxel size, fragment shading)\n\n");
+        md += strCat("| scene | segments | image ", stageHeader(), "\n");
+        md += "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+        for (const BenchRow& r : rows)
+            if (r.kind == fit.kind)
+                md += strCat("| ", r.scene, " | ", thousands(r.m.segments), " | ", imageSize(r),
+                             " |", stageCells(r.m), "\n");
+        const char* x = segments ? "segments" : "pixels";
+        md += strCat(
+            "\nGrowth, least-squares fit of cost ∝ ", x, "^k: ", fitText("total time", fit.total),
+            "; ", fitText("voxelize", fit.voxelize), "; ", fitText("global term", fit.globalTerm),
+            "; ", fitText("raster + shade", fit.rasterShade), "; ",
+            fitText("peak memory", fit.peakMemory), ".\n\n");
+    }
+    return md;
+}
+
+std::vector<ScalingFit> fitScaling(const std::vector<BenchRow>& rows) {
+    std::vector<ScalingFit> fits;
+    for (const BenchSweepKind kind : {BenchSweepKind::Segments, BenchSweepKind::Pixels}) {
+        std::vector<double> x, total, voxelize, globalTerm, rasterShade, memX, memory;
+        for (const BenchRow& r : rows) {
+            if (r.kind != kind)
+                continue;
+            const double size = kind == BenchSweepKind::Segments
+                                    ? double(r.m.segments)
+                                    : double(r.width) * double(r.height);
+            x.push_back(size);
+            total.push_back(r.m.totalSeconds);
+            voxelize.push_back(r.m.times.voxelize);
+            globalTerm.push_back(r.m.times.globalTerm);
+            rasterShade.push_back(r.m.times.raster + r.m.times.shade);
+            if (r.m.peakMiB) {
+                memX.push_back(size);
+                memory.push_back(*r.m.peakMiB);
+            }
+        }
+        if (x.empty())
+            continue;
+        ScalingFit fit;
+        fit.kind = kind;
+        fit.total = fitPowerLaw(x, total);
+        fit.voxelize = fitPowerLaw(x, voxelize);
+        fit.globalTerm = fitPowerLaw(x, globalTerm);
+        fit.rasterShade = fitPowerLaw(x, rasterShade);
+        fit.peakMemory = fitPowerLaw(memX, memory);
+        fits.push_back(fit);
+    }
+    return fits;
+}
+
+std::string fitsCsvText(const std::vector<ScalingFit>& fits) {
+    std::string out = "kind,stage,exponent,coefficient,r2\n";
+    for (const ScalingFit& fit : fits) {
+        const std::pair<const char*, const std::optional<PowerLawFit>*> stages[] = {
+            {"total", &fit.total},
+            {"voxelize", &fit.voxelize},
+            {"global term", &fit.globalTerm},
+            {"raster+shade", &fit.rasterShade},
+            {"peak memory", &fit.peakMemory}};
+        for (const auto& [stage, f] : stages)
+            if (*f)
+                out +=
+                    strCat(toString(fit.kind), ",", stage, ",", format("%.6g", (*f)->exponent), ",",
+                           format("%.6g", (*f)->coefficient), ",", format("%.6g", (*f)->r2), "\n");
+    }
+    return out;
+}
+
+} // namespace hairvox::bench

@@ -1,0 +1,382 @@
+#include "job.h"
+#include "measure.h"
+#include "plots.h"
+#include "report.h"
+#include "text.h"
+
+#include <hairvox/bench/sweep.h>
+#include <hairvox/core/error.h>
+#include <hairvox/core/interrupt.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <set>
+
+namespace hairvox {
+
+using namespace bench;
+using nlohmann::json;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+/// The output directory's working files, removed however the sweep ends.
+class WorkDir {
+public:
+    explicit WorkDir(std::filesystem::path path)
+        : path_(std::move(path)) {
+        std::filesystem::remove_all(path_);
+        std::filesystem::create_directories(path_ / "scratch");
+    }
+    ~WorkDir() {
+        std::error_code ec;
+        std::filesystem::remove_all(path_, ec);
+    }
+    WorkDir(const WorkDir&) = delete;
+    WorkDir& operator=(const WorkDir&) = delete;
+    const std::filesystem::path& path() const { return path_; }
+
+private:
+    std::filesystem::path path_;
+};
+
+/// Writes results.csv, results.md, scaling_fits.csv and the plots.
+std::vector<std::filesystem::path> writeSweepOutputs(const SweepOptions& o, SweepResult& result,
+                                                     const RunInfo& info,
+                                                     const std::filesystem::path& workDir) {
+    result.fits = fitScaling(result.rows);
+    std::vector<std::filesystem::path> written;
+    const auto writeText = [&](const std::filesystem::path& path, const std::string& text) {
+        writeTextFile(path, text);
+        written.push_back(path);
+    };
+    writeText(o.outDir / "results.csv", csvText(result.rows));
+    writeText(o.outDir / "results.md", markdownText(o, result, info));
+    writeText(o.outDir / "scaling_fits.csv", fitsCsvText(result.fits));
+    const PlotResult plots = drawPlots(o.outDir, workDir);
+    if (!plots.problem.empty() && o.log)
+        *o.log << "bench: warning: no plots drawn: " << plots.problem << std::endl;
+    written.insert(written.end(), plots.written.begin(), plots.written.end());
+    return written;
+}
+
+} // namespace
+
+Scene BenchScene::build() const {
+    if (style && !file.empty())
+        throw InputError(strCat(label, ": a groom style swap applies to the default scene only"));
+    Scene scene = file.empty() ? defaultScene() : loadScene(file);
+    if (style) {
+        scene.groom.procedural.style = *style;
+        scene.groom.procedural.pointsPerStrand = pointsPerStrand;
+    }
+    if ((strands > 0 || pointsPerStrand > 0) && !scene.groom.isProcedural())
+        throw InputError(
+            strCat(label, ": strand and point counts apply to procedural grooms only"));
+    if (strands > 0)
+        scene.groom.procedural.strands = strands;
+    if (pointsPerStrand > 0)
+        scene.groom.procedural.pointsPerStrand = pointsPerStrand;
+    if (width > 0)
+        scene.camera.width = width;
+    if (height > 0)
+        scene.camera.height = height;
+    scene.name = label;
+    scene.output.exr.clear();
+    scene.output.png.clear();
+    scene.validate();
+    return scene;
+}
+
+std::string BenchConfig::label() const {
+    if (mode == GlobalTermMode::Exact)
+        return strCat("exact K=", rays);
+    return strCat(toString(mode), " x", scaleText(voxelScale));
+}
+
+std::optional<PowerLawFit> fitPowerLaw(std::span<const double> x, std::span<const double> y) {
+    if (x.size() != y.size())
+        throw InputError(
+            strCat("fitPowerLaw: ", x.size(), " x values but ", y.size(), " y values"));
+    std::vector<double> lx, ly;
+    for (std::size_t i = 0; i < x.size(); ++i)
+        if (x[i] > 0 && y[i] > 0 && std::isfinite(x[i]) && std::isfinite(y[i])) {
+            lx.push_back(std::log(x[i]));
+            ly.push_back(std::log(y[i]));
+        }
+    const double n = double(lx.size());
+    if (lx.size() < 2)
+        return std::nullopt;
+    double mx = 0, my = 0;
+    for (std::size_t i = 0; i < lx.size(); ++i) {
+        mx += lx[i] / n;
+        my += ly[i] / n;
+    }
+    double sxx = 0, sxy = 0, syy = 0;
+    for (std::size_t i = 0; i < lx.size(); ++i) {
+        sxx += (lx[i] - mx) * (lx[i] - mx);
+        sxy += (lx[i] - mx) * (ly[i] - my);
+        syy += (ly[i] - my) * (ly[i] - my);
+    }
+    if (!(sxx > 1e-24))
+        return std::nullopt;
+    PowerLawFit fit;
+    fit.exponent = sxy / sxx;
+    const double intercept = my - fit.exponent * mx;
+    fit.coefficient = std::exp(intercept);
+    double residual = 0;
+    for (std::size_t i = 0; i < lx.size(); ++i) {
+        const double r = ly[i] - (intercept + fit.exponent * lx[i]);
+        residual += r * r;
+    }
+    fit.r2 = syy > 0 ? 1.0 - residual / syy : 1.0;
+    return fit;
+}
+
+SweepOptions SweepOptions::full(const std::filesystem::path& ratboyScene) {
+    SweepOptions o;
+    const auto style = [](const char* label, GroomStyle s) {
+        BenchScene b;
+        b.label = label;
+        b.style = s;
+        return b;
+    };
+    BenchScene wavy;
+    wavy.label = "wavy (default scene)";
+    BenchScene ratboy;
+    ratboy.label = "Ratboy mohawk";
+    ratboy.file = ratboyScene;
+    BenchScene head;
+    head.label = "wavy head 1.4M";
+    head.strands = 50000;
+    head.pointsPerStrand = 29;
+    head.width = 1920;
+    head.height = 1080;
+    o.scenes = {style("straight", GroomStyle::Straight), wavy, style("curly", GroomStyle::Curly),
+                ratboy, head};
+    o.voxelScales = {4, 2, 1.4, 1, 0.7};
+    o.exactRays = {1, 4};
+    o.referenceRays = 16;
+    // 10k … 1.4M segments: 28 segments per strand.
+    for (const std::uint32_t strands : {357u, 1071u, 3571u, 10714u, 25000u, 50000u}) {
+        BenchScene s = head;
+        s.label = strCat("wavy ", strands, " strands");
+        s.strands = strands;
+        o.segmentScaling.push_back(s);
+    }
+    for (const std::uint32_t size : {256u, 512u, 1024u, 2048u}) {
+        BenchScene s;
+        s.label = strCat("default scene ", size, "^2");
+        s.width = s.height = size;
+        o.pixelScaling.push_back(s);
+    }
+    return o;
+}
+
+SweepOptions SweepOptions::quick() {
+    SweepOptions o;
+    BenchScene wavy;
+    wavy.label = "wavy (default scene) 512^2";
+    wavy.width = wavy.height = 512;
+    BenchScene curly = wavy;
+    curly.label = "curly 512^2";
+    curly.style = GroomStyle::Curly;
+    o.scenes = {wavy, curly};
+    o.voxelScales = {4, 2, 1};
+    o.exactRays = {1};
+    o.referenceRays = 4;
+    o.shadingRates = {ShadingRate::Fragment};
+    o.probePoints = 500;
+    o.runs = 1;
+    for (const std::uint32_t strands : {357u, 3571u, 14286u}) {
+        BenchScene s;
+        s.label = strCat("wavy ", strands, " strands");
+        s.strands = strands;
+        s.pointsPerStrand = 29;
+        s.width = 960;
+        s.height = 540;
+        o.segmentScaling.push_back(s);
+    }
+    for (const std::uint32_t size : {256u, 512u, 1024u}) {
+        BenchScene s;
+        s.label = strCat("default scene ", size, "^2");
+        s.width = s.height = size;
+        o.pixelScaling.push_back(s);
+    }
+    return o;
+}
+
+void SweepOptions::validate() const {
+    if (scenes.empty() && segmentScaling.empty() && pixelScaling.empty())
+        throw InputError("bench: nothing to measure (no scenes and no scaling sweep)");
+    std::set<std::string> labels;
+    for (const auto* list : {&scenes, &segmentScaling, &pixelScaling})
+        for (const BenchScene& s : *list) {
+            if (!s.file.empty() && !std::filesystem::exists(s.file))
+                throw InputError(strCat(s.file.string(),
+                                        ": no such scene file (the default sweep "
+                                        "reads data/scenes/ under the working directory: run it "
+                                        "from the repository root, or pass --scene)"));
+            if (!labels.insert(s.label).second)
+                throw InputError(strCat("bench: two scenes are labelled \"", s.label, "\""));
+        }
+    if (!scenes.empty() && (voxelScales.empty() || shadingRates.empty()))
+        throw InputError("bench: give at least one voxel size and one shading rate");
+    for (const double s : voxelScales)
+        if (!(s >= 1.0 / 64 && s <= 64))
+            throw InputError(strCat("bench: voxel scale ", s, " outside [1/64, 64]"));
+    for (const std::uint32_t k : exactRays)
+        if (k < 1 || k > 65536)
+            throw InputError(strCat("bench: exact rays ", k, " outside [1, 65536]"));
+    if (referenceRays < 1 || referenceRays > 65536 || probeRays < 1 || probeRays > 65536)
+        throw InputError("bench: reference and probe rays must be in [1, 65536]");
+    if (runs < 1 || runs > 100)
+        throw InputError(strCat("bench: runs ", runs, " outside [1, 100]"));
+    if (!(singleRunAbove >= 0))
+        throw InputError(strCat("bench: singleRunAbove ", singleRunAbove, " should be ≥ 0"));
+    if (outDir.empty())
+        throw InputError("bench: empty output directory");
+}
+
+void runBenchJobFile(const std::filesystem::path& jobFile) {
+    BenchJob job;
+    try {
+        job = jobFromJson(readJsonFile(jobFile));
+    } catch (const json::exception& e) {
+        throw InputError(strCat(jobFile.string(), ": not a benchmark job: ", e.what()));
+    }
+    writeJsonFile(job.result, measurementToJson(runJob(job)));
+}
+
+SweepResult runSweep(const SweepOptions& o) {
+    o.validate();
+    for (const auto* list : {&o.scenes, &o.segmentScaling, &o.pixelScaling})
+        for (const BenchScene& s : *list)
+            s.build(); // every scene is valid before hours of work start
+    std::filesystem::create_directories(o.outDir);
+    const WorkDir work(o.outDir / ".work");
+    RunInfo info = RunInfo::now();
+
+    std::vector<double> probeScales = o.voxelScales;
+    if (std::find(probeScales.begin(), probeScales.end(), 1.0) == probeScales.end())
+        probeScales.push_back(1.0); // the exact configurations' footprint
+    const std::size_t perScene =
+        1 + o.shadingRates.size() * (o.exactRays.size() + 2 * o.voxelScales.size());
+    const std::size_t jobCount =
+        o.scenes.size() * perScene + o.segmentScaling.size() + o.pixelScaling.size();
+    std::size_t jobIndex = 0;
+    const auto start = Clock::now();
+
+    SweepResult result;
+    const auto run = [&](BenchJob job, BenchSweepKind kind) {
+        throwIfInterrupted();
+        const double load = loadAverage();
+        info.loadMax = std::max(info.loadMax, load);
+        job.runs = kind == BenchSweepKind::Reference ? 1 : o.runs;
+        job.singleRunAbove = o.singleRunAbove;
+        job.threads = o.threads;
+        job.isolated = !o.workerCommand.empty();
+        job.scratch = work.path() / "scratch";
+        const std::filesystem::path jobFile = work.path() / strCat("job-", jobIndex, ".json");
+        job.result = work.path() / strCat("job-", jobIndex, ".result.json");
+        ++jobIndex;
+        writeJsonFile(jobFile, jobToJson(job));
+        if (o.workerCommand.empty())
+            runBenchJobFile(jobFile);
+        else
+            runWorker(o.workerCommand, jobFile);
+        BenchRow row;
+        row.kind = kind;
+        row.scene = job.scene.label;
+        row.config = job.config;
+        const Scene scene = job.scene.build();
+        row.width = scene.camera.width;
+        row.height = scene.camera.height;
+        row.m = measurementFromJson(readJsonFile(job.result));
+        if (o.log) {
+            const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+            std::string line = strCat("[", jobIndex, "/", jobCount, " ", int(elapsed) / 60, ":",
+                                      format("%02.0f", std::fmod(std::floor(elapsed), 60.0)), "] ",
+                                      row.scene, ", ", configText(row));
+            if (kind == BenchSweepKind::Accuracy)
+                line += strCat(", ", toString(row.config.shadingRate));
+            line += strCat(": ", seconds(row.m.totalSeconds), " s (global term ",
+                           seconds(row.m.times.globalTerm), " s)");
+            if (row.m.peakMiB)
+                line += strCat(", ", format("%.0f", *row.m.peakMiB), " MiB");
+            if (row.m.image)
+                line += strCat(", rel L1 ", format("%.4f", row.m.image->relL1));
+            if (row.m.probe)
+                line += strCat(", MAE(V) ", format("%.4f", row.m.probe->maeV), ", MAE(T_s) ",
+                               format("%.4f", row.m.probe->maeT_s));
+            *o.log << line << "   [load " << format("%.1f", load) << "]" << std::endl;
+        }
+        result.rows.push_back(row);
+        return row.m;
+    };
+
+    for (std::size_t si = 0; si < o.scenes.size(); ++si) {
+        const BenchScene& scene = o.scenes[si];
+        BenchJob ref;
+        ref.reference = true;
+        ref.scene = scene;
+        ref.config = {GlobalTermMode::Exact, 1.0, o.referenceRays, ShadingRate::Fragment};
+        ref.referenceImage = work.path() / strCat("scene-", si, "-reference.bin");
+        ref.probePoints = o.probePoints;
+        ref.probeSeed = o.probeSeed;
+        ref.probeRays = o.probeRays;
+        ref.probeScales = probeScales;
+        for (std::size_t i = 0; i < probeScales.size(); ++i)
+            ref.probeFiles.push_back(work.path() / strCat("scene-", si, "-probe-", i, ".bin"));
+        const double h0 = run(ref, BenchSweepKind::Reference).defaultVoxelSize;
+
+        std::vector<BenchConfig> configs;
+        for (const std::uint32_t k : o.exactRays)
+            configs.push_back({GlobalTermMode::Exact, 1.0, k, ShadingRate::Fragment});
+        for (const GlobalTermMode mode : {GlobalTermMode::Grid, GlobalTermMode::Approx})
+            for (const double s : o.voxelScales)
+                configs.push_back({mode, s, 1, ShadingRate::Fragment});
+        for (const BenchConfig& base : configs) {
+            std::optional<ProbeError> probe; // independent of the shading rate: measured once
+            for (const ShadingRate rate : o.shadingRates) {
+                BenchJob job;
+                job.scene = scene;
+                job.config = base;
+                job.config.shadingRate = rate;
+                job.voxelSize = base.voxelScale * h0;
+                job.referenceImage = ref.referenceImage;
+                if (!probe && o.probePoints > 0) {
+                    job.probePoints = o.probePoints;
+                    job.probeSeed = o.probeSeed;
+                    const auto at =
+                        std::find(probeScales.begin(), probeScales.end(), base.voxelScale);
+                    job.probeFiles = {ref.probeFiles[std::size_t(at - probeScales.begin())]};
+                }
+                const BenchMeasurement m = run(job, BenchSweepKind::Accuracy);
+                if (m.probe)
+                    probe = m.probe;
+                else
+                    result.rows.back().m.probe = probe;
+            }
+        }
+        info.loadEnd = loadAverage(); // so far: the outputs are complete up to this scene
+        result.written = writeSweepOutputs(o, result, info, work.path());
+    }
+
+    for (const auto& [list, kind] : {std::pair{&o.segmentScaling, BenchSweepKind::Segments},
+                                     std::pair{&o.pixelScaling, BenchSweepKind::Pixels}})
+        for (const BenchScene& scene : *list) {
+            BenchJob job;
+            job.scene = scene;
+            job.config = {GlobalTermMode::Grid, 1.0, 1, ShadingRate::Fragment};
+            run(job, kind);
+        }
+    info.loadEnd = loadAverage();
+    info.loadMax = std::max(info.loadMax, info.loadEnd);
+    result.written = writeSweepOutputs(o, result, info, work.path());
+    return result;
+}
+
+} // namespace hairvox

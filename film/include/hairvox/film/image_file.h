@@ -1,0 +1,68 @@
+// hairvox film: writing a film to image files, and reading EXR back.
+//
+// EXR: every layer of the film (film.h) as half channels — as float where a
+// value exceeds half's range, or where the layer asks for full precision
+// (depth) — ZIPS-compressed, with the string attributes and the camera's
+// world-to-camera matrix given by the caller (OpenEXR's standard
+// `worldToCamera` attribute). Written through writeFileAtomically().
+//
+// PNG: an 8-bit sRGB preview of the beauty: linear · 2^exposure, tone mapped
+// (`clamp`, or `filmic`: Narkowicz's 2015 fit of the ACES curve, per
+// channel), then the sRGB transfer function, rounded. The alpha channel is not
+// written (the background is part of the beauty).
+#pragma once
+
+#include <hairvox/core/enum_names.h>
+#include <hairvox/film/film.h>
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace hairvox {
+
+/// Preview tone map of the PNG.
+enum class ToneMap { Clamp, Filmic };
+
+inline constexpr EnumNames<ToneMap, 2> kToneMapNames{{{
+    {ToneMap::Filmic, "filmic"},
+    {ToneMap::Clamp, "clamp"},
+}}};
+inline const char* toString(ToneMap t) {
+    return kToneMapNames.name(t);
+}
+
+/// Row-major 4×4 matrix, OpenEXR's convention (row vectors).
+using Matrix44 = std::array<std::array<float, 4>, 4>;
+
+struct ExrHeader {
+    std::optional<Matrix44> worldToCamera;
+    std::map<std::string, std::string> attributes; ///< e.g. "hairvox:globalTermMode" → "grid"
+};
+
+/// Writes every layer of the film as one multi-layer EXR, atomically.
+void writeExr(const std::filesystem::path& path, const Film& film, const ExrHeader& header = {});
+
+/// An EXR file read back: every channel as float, row-major, and the string
+/// attributes (tests, reference images, image comparisons).
+struct ExrImage {
+    int width = 0, height = 0;
+    std::map<std::string, std::vector<float>> channels;
+    std::map<std::string, std::string> attributes;
+};
+
+/// Throws InputError naming the file if it cannot be read.
+ExrImage readExr(const std::filesystem::path& path);
+
+/// The tone-mapped 8-bit sRGB preview of the film's beauty, row-major RGB.
+std::vector<std::uint8_t> previewPixels(const Film& film, float exposure, ToneMap toneMap);
+
+/// Writes 8-bit RGB pixels (row-major, 3 bytes a pixel) as a PNG, atomically.
+void writePng(const std::filesystem::path& path, int width, int height,
+              const std::vector<std::uint8_t>& rgb);
+
+} // namespace hairvox

@@ -1,0 +1,63 @@
+#include <hairvox/core/atomic_file.h>
+#include <hairvox/core/error.h>
+#include <hairvox/film/image_file.h>
+
+#include <png.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace hairvox {
+
+namespace {
+
+/// Narkowicz 2015, "ACES Filmic Tone Mapping Curve": a fit of the ACES
+/// reference rendering and output transforms, per channel.
+float filmic(float x) {
+    return std::clamp((x * (2.51f * x + 0.03f)) / (x * (2.43f * x + 0.59f) + 0.14f), 0.0f, 1.0f);
+}
+
+/// The sRGB transfer function (IEC 61966-2-1) of a value in [0, 1].
+float srgbEncode(float v) {
+    return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+}
+
+} // namespace
+
+std::vector<std::uint8_t> previewPixels(const Film& film, float exposure, ToneMap toneMap) {
+    const float scale = std::exp2(exposure);
+    std::vector<std::uint8_t> out(film.pixelCount() * 3);
+    const FilmLayer& beauty = film.layer(Film::kBeauty);
+    for (std::size_t p = 0; p < film.pixelCount(); ++p) {
+        const Rgb c = beauty.rgb(p);
+        for (int ch = 0; ch < 3; ++ch) {
+            const float x = std::max(c[ch] * scale, 0.0f);
+            const float mapped = toneMap == ToneMap::Filmic ? filmic(x) : std::min(x, 1.0f);
+            out[p * 3 + std::size_t(ch)] =
+                static_cast<std::uint8_t>(std::lround(255.0f * srgbEncode(mapped)));
+        }
+    }
+    return out;
+}
+
+void writePng(const std::filesystem::path& path, int width, int height,
+              const std::vector<std::uint8_t>& rgb) {
+    if (width < 0 || height < 0 || rgb.size() != std::size_t(width) * std::size_t(height) * 3)
+        throw std::logic_error(
+            strCat("writePng: ", rgb.size(), " bytes for ", width, " x ", height));
+    writeFileAtomically(path, [&](const std::filesystem::path& tmp) {
+        png_image image{};
+        image.version = PNG_IMAGE_VERSION;
+        image.width = static_cast<png_uint_32>(width);
+        image.height = static_cast<png_uint_32>(height);
+        image.format = PNG_FORMAT_RGB;
+        if (!png_image_write_to_file(&image, tmp.c_str(), 0, rgb.data(), 0, nullptr)) {
+            const std::string message = image.message;
+            png_image_free(&image);
+            throw InputError(strCat(path.string(), ": cannot write PNG file: ", message));
+        }
+    });
+}
+
+} // namespace hairvox

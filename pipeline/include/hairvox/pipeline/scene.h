@@ -1,0 +1,118 @@
+// hairvox pipeline: the scene — everything a render needs besides the groom's
+// points: fiber scale and optics, lights, camera, the opaque head, global-term
+// and output settings. Read from a JSON scene file whose schema (with an example
+// per feature) is docs/scene.md; the embedded default scene is
+// data/scenes/default.json, compiled into the library.
+//
+// Validation follows DEVELOPERS.md: every error is an InputError naming the
+// file, the JSON path and the valid range or type, e.g.
+//   scene.json: /lights/1/intensity: expected a number in [0, 1e+06], got "bright"
+// Unknown keys are errors (a typo must not be silently ignored). Ranges of the
+// fiber scale and optics and the procedural groom are those of
+// FiberScale::validate(), FiberParams::validate(), DualScatteringParams::validate()
+// and ProceduralGroomParams::validate().
+#pragma once
+
+#include <hairvox/core/rgb.h>
+#include <hairvox/core/vecmath.h>
+#include <hairvox/film/image_file.h>
+#include <hairvox/geometry/camera.h>
+#include <hairvox/geometry/light.h>
+#include <hairvox/render/fragment_shader.h>
+#include <hairvox/shading/fiber_params.h>
+#include <hairvox/strands/fiber_scale.h>
+#include <hairvox/strands/procedural.h>
+#include <hairvox/transmittance/global_term_mode.h>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace hairvox {
+
+/// Where the strands come from: a groom file or the procedural generator.
+struct GroomSource {
+    /// .hair/.tfx/.obj, resolved against the scene file's directory; empty → procedural.
+    std::filesystem::path file;
+    ProceduralGroomParams procedural;
+
+    bool isProcedural() const { return file.empty(); }
+};
+
+/// The optional opaque head: hides the hair behind it, blocks light, and is
+/// drawn with a Lambertian BRDF lit by the scene's lights (not shadowed by the hair).
+struct Head {
+    Sphere sphere{Vec3f(0.0f), 0.1f}; ///< radius in [1e-6, 1e4]
+    Rgb albedo{0.55f, 0.40f, 0.33f};  ///< diffuse reflectance, each channel in [0, 1]
+};
+
+/// Options of the `exact` global-term mode (DESIGN.md §5–6): K shadow rays per
+/// shading point from a disk of radius r perpendicular to the light.
+struct ExactSettings {
+    std::uint32_t rays = 1; ///< K, [1, 65536]
+    float radius = 0;       ///< r, scene units, [0, 1000]
+};
+
+struct OutputSettings {
+    std::filesystem::path exr;         ///< relative to the working directory; empty: not written
+    std::filesystem::path png;         ///< relative to the working directory; empty: not written
+    float exposure = 0;                ///< stops applied to the PNG preview only, [-20, 20]
+    ToneMap toneMap = ToneMap::Filmic; ///< of the PNG preview (film/image_file.h)
+};
+
+struct Scene {
+    std::string name; ///< where the scene came from (file name or "default scene"), for messages
+    GroomSource groom;
+    FiberScale fiberScale; ///< D (scene units: m for the procedural grooms) and k
+    FiberParams fiber;
+    DualScatteringParams dualScattering;
+    std::vector<Light> lights; ///< at most 16 (each adds per-light AOV layers)
+    CameraParams camera;
+    std::optional<Head> head;
+    std::optional<float> voxelSize; ///< fiber grid voxel size; nullopt: derived from the groom
+    GlobalTermMode globalTermMode = GlobalTermMode::Grid;
+    ExactSettings exact;
+    ShadingRate shadingRate = ShadingRate::Fragment;
+    Rgb background{0.0f}; ///< radiance behind everything, each channel in [0, 1e6]
+    OutputSettings output;
+
+    /// Re-checks every field and the cross-field rules (camera outside the
+    /// head, unique light names, a valid camera frame) — call it after
+    /// overriding fields from the command line. parseScene() already did.
+    /// Messages name the field (e.g. "camera.resolution").
+    void validate() const;
+};
+
+std::ostream& operator<<(std::ostream& os, const Scene& scene);
+
+inline constexpr std::size_t kMaxLights = 16;
+inline constexpr std::uint64_t kMaxProceduralPoints = 1ull << 26;
+
+/// Reads and validates a scene file (at most 16 MiB). Relative groom paths are
+/// resolved against the file's directory.
+Scene loadScene(const std::filesystem::path& path);
+
+/// Validates a parsed JSON document. `sourceName` prefixes error messages and
+/// names the default outputs (out/<stem>.exr, out/<stem>.png); `baseDir`
+/// resolves a relative groom file.
+Scene parseScene(const nlohmann::json& json, const std::string& sourceName,
+                 const std::filesystem::path& baseDir);
+
+/// Parses JSON text, then parseScene() (syntax errors name line and column).
+Scene parseSceneText(std::string_view text, const std::string& sourceName,
+                     const std::filesystem::path& baseDir);
+
+/// The embedded default scene (data/scenes/default.json): a procedural
+/// light-blond wavy groom on a head, a key and a back light, 1024², grid mode,
+/// writing out/default.exr and out/default.png.
+Scene defaultScene();
+/// Its JSON text, as compiled in.
+std::string_view defaultSceneJson();
+
+} // namespace hairvox

@@ -1,0 +1,51 @@
+// hairvox pipeline (private): the FragmentShader of a dual-scattering render —
+// the dual-scattering shader (shading/) fed with each light's global term
+// (transmittance/), weighted by each light's irradiance.
+//
+// Layout (render/fragment_shader.h), the EXR layers of a render:
+//   radiance  direct_R, direct_TT, direct_TRT   V·f_p·cos θ_i per lobe (single scattering)
+//             back_direct                      V·d_b·f_back^direct·cos θ_i (local multiple
+//             scattering) scatter                          F_scatter·cos θ_i (global multiple
+//             scattering)
+//   averages  per light l: l.V, l.n (scalars), l.T_s, l.sigma_f (RGB, σ_f = √σ_f²)
+#pragma once
+
+#include <hairvox/geometry/light.h>
+#include <hairvox/render/fragment_shader.h>
+#include <hairvox/shading/dual_scattering_shader.h>
+#include <hairvox/transmittance/global_term_model.h>
+
+#include <atomic>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+namespace hairvox::detail {
+
+class DualScatteringFragmentShader final : public FragmentShader {
+public:
+    /// `lightTerms[l]` is the global term toward lights[l], or null for a light
+    /// that is skipped (contributes nothing; its AOVs read "blocked").
+    DualScatteringFragmentShader(const DualScatteringShader& shader, std::vector<Light> lights,
+                                 std::vector<std::unique_ptr<LightGlobalTerm>> lightTerms);
+
+    const ShaderLayout& layout() const override { return layout_; }
+    void shade(std::span<const ShadingPoint> points, std::span<float> out) const override;
+
+    /// Thread-seconds spent evaluating the global term, and in shade() overall.
+    double globalTermThreadSeconds() const { return 1e-9 * double(globalTermNanos_.load()); }
+    double shadeThreadSeconds() const { return 1e-9 * double(shadeNanos_.load()); }
+    /// Per light, summed over every batch.
+    std::vector<GlobalTermStats> stats() const;
+
+private:
+    DualScatteringShader shader_;
+    std::vector<Light> lights_;
+    std::vector<std::unique_ptr<LightGlobalTerm>> terms_;
+    ShaderLayout layout_;
+    mutable std::atomic<std::int64_t> globalTermNanos_{0}, shadeNanos_{0};
+    mutable std::mutex statsMutex_;
+    mutable std::vector<GlobalTermStats> stats_;
+};
+
+} // namespace hairvox::detail

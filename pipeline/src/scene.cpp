@@ -1,0 +1,456 @@
+#include "json_reader.h"
+
+#include <hairvox/core/error.h>
+#include <hairvox/pipeline/scene.h>
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <fstream>
+#include <iterator>
+
+namespace hairvox {
+
+using json::JsonObject;
+using json::JsonValue;
+using json::Range;
+
+namespace {
+
+// Valid ranges of the scene's own fields, used by the JSON reader (with the
+// JSON path) and by Scene::validate() (with the field name).
+constexpr Range kCoordinate{-1e6, 1e6};
+constexpr Range kLightColor{0.0, 1000.0};
+constexpr Range kLightIntensity{0.0, 1e6};
+constexpr Range kFovDegrees{0.1, 170.0};
+constexpr Range kHeadRadius{1e-6, 1e4};
+constexpr Range kAlbedo{0.0, 1.0};
+constexpr Range kVoxelSize{0.0, 1000.0, true};
+constexpr std::uint64_t kMaxExactRays = 65536;
+constexpr Range kExactRadius{0.0, 1000.0};
+constexpr Range kBackground{0.0, 1e6};
+constexpr Range kExposure{-20.0, 20.0};
+constexpr Range kDegrees{-360.0, 360.0};
+constexpr Range kAny{-1e30, 1e30};
+constexpr std::size_t kMaxLightNameLength = 32;
+constexpr std::uintmax_t kMaxSceneFileBytes = 16u << 20;
+
+/// Calls `check` (an owner's validate()) and re-throws its InputError under
+/// the JSON path of the value that was just read.
+template <typename At, typename F>
+void checkAt(const At& at, F&& check) {
+    try {
+        check();
+    } catch (const InputError& e) {
+        at.fail(e.what());
+    }
+}
+
+void requireInRange(const std::string& field, double x, const Range& range) {
+    if (!range.contains(x))
+        throw InputError(strCat(field, " = ", x, ": expected a number ", range.describe()));
+}
+
+void requireInRange(const std::string& field, const Vec3f& v, const Range& range) {
+    for (int c = 0; c < 3; ++c)
+        requireInRange(field, double(v[c]), range);
+}
+
+void requireInRange(const std::string& field, const Rgb& v, const Range& range) {
+    for (int c = 0; c < 3; ++c)
+        requireInRange(field, double(v[c]), range);
+}
+
+constexpr const char* kLightNameRule = "a name of 1 to 32 letters, digits, '_' or '-'";
+
+/// Light names prefix EXR layer names, which must not contain '.'.
+bool isValidLightName(const std::string& name) {
+    if (name.empty() || name.size() > kMaxLightNameLength)
+        return false;
+    return std::all_of(name.begin(), name.end(), [](char c) {
+        return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+               c == '_' || c == '-';
+    });
+}
+
+// --- groom -----------------------------------------------------------------
+
+ProceduralGroomParams parseProcedural(JsonObject obj) {
+    ProceduralGroomParams p;
+    // Each value is checked by ProceduralGroomParams::validate() right after it
+    // is set (the others are still valid), so a range error names its own path.
+    auto set = [&](std::string_view key, auto assign) {
+        const JsonValue v = obj[key];
+        if (!v.present())
+            return;
+        assign(v);
+        checkAt(v, [&] { p.validate(); });
+    };
+    set("style", [&](const JsonValue& v) { p.style = v.oneOf(kGroomStyleNames); });
+    set("strands", [&](const JsonValue& v) {
+        p.strands = static_cast<std::uint32_t>(v.integer(1, 10'000'000));
+    });
+    set("points_per_strand", [&](const JsonValue& v) {
+        p.pointsPerStrand = static_cast<std::uint32_t>(v.integer(2, 4096));
+    });
+    set("seed", [&](const JsonValue& v) {
+        p.seed = v.integer(0, std::numeric_limits<std::uint64_t>::max());
+    });
+    set("length", [&](const JsonValue& v) { p.length = v.numberF(kAny); });
+    set("length_variation", [&](const JsonValue& v) { p.lengthVariation = v.numberF(kAny); });
+    set("wave_amplitude", [&](const JsonValue& v) { p.waveAmplitude = v.numberF(kAny); });
+    set("wave_length", [&](const JsonValue& v) { p.waveLength = v.numberF(kAny); });
+    set("curl_radius", [&](const JsonValue& v) { p.curlRadius = v.numberF(kAny); });
+    set("curl_pitch", [&](const JsonValue& v) { p.curlPitch = v.numberF(kAny); });
+    set("clump_strength", [&](const JsonValue& v) { p.clumpStrength = v.numberF(kAny); });
+    set("head_center", [&](const JsonValue& v) { p.headCenter = v.vec3(kCoordinate); });
+    set("head_radius", [&](const JsonValue& v) { p.headRadius = v.numberF(kAny); });
+    obj.finish();
+    const std::uint64_t points = std::uint64_t(p.strands) * p.resolvedPointsPerStrand();
+    if (points > kMaxProceduralPoints)
+        obj["strands"].fail(strCat(p.strands, " strands x ", p.resolvedPointsPerStrand(),
+                                   " points = ", points, " points: expected at most ",
+                                   kMaxProceduralPoints));
+    return p;
+}
+
+GroomSource parseGroom(JsonObject obj, const std::filesystem::path& baseDir) {
+    GroomSource g;
+    const JsonValue file = obj["file"];
+    const JsonValue procedural = obj["procedural"];
+    if (file.present() == procedural.present())
+        obj.fail("expected exactly one of \"file\" and \"procedural\"");
+    if (file.present()) {
+        const std::string name = file.string();
+        if (name.empty())
+            file.failExpected("a non-empty path");
+        const std::filesystem::path path(name);
+        g.file = path.is_absolute() ? path : baseDir / path;
+    } else {
+        g.procedural = parseProcedural(procedural.object());
+    }
+    obj.finish();
+    return g;
+}
+
+// --- fiber -------------------------------------------------------------------
+
+void parseFiber(JsonObject obj, Scene& scene) {
+    const auto setScale = [&](std::string_view key, float FiberScale::*field) {
+        const JsonValue v = obj[key];
+        if (!v.present())
+            return;
+        scene.fiberScale.*field = v.numberF(kAny);
+        checkAt(v, [&] { scene.fiberScale.validate(); });
+    };
+    setScale("diameter", &FiberScale::diameter);
+    setScale("density_multiplier", &FiberScale::densityMultiplier);
+
+    FiberParams& f = scene.fiber;
+    auto set = [&](std::string_view key, auto assign) {
+        const JsonValue v = obj[key];
+        if (!v.present())
+            return;
+        assign(v);
+        checkAt(v, [&] { f.validate(); });
+    };
+    set("eta", [&](const JsonValue& v) { f.eta = v.numberF(kAny); });
+    const JsonValue melanin = obj["melanin"];
+    if (melanin.present() && obj.has("sigma_a"))
+        melanin.fail("give either sigma_a or melanin, not both");
+    set("sigma_a", [&](const JsonValue& v) { f.sigma_a = v.rgb(kAny); });
+    if (melanin.present()) {
+        JsonObject m = melanin.object();
+        const JsonValue eu = m["eumelanin"], pheo = m["pheomelanin"];
+        const float c_eu = eu.present() ? eu.numberF(kAny) : 0.0f;
+        const float c_pheo = pheo.present() ? pheo.numberF(kAny) : 0.0f;
+        m.finish();
+        checkAt(melanin, [&] { f.sigma_a = FiberParams::sigmaFromMelanin(c_eu, c_pheo); });
+        checkAt(melanin, [&] { f.validate(); });
+    }
+    set("alpha_R", [&](const JsonValue& v) { f.alpha_R = radians(v.numberF(kDegrees)); });
+    set("beta_R", [&](const JsonValue& v) { f.beta_R = radians(v.numberF(kDegrees)); });
+    set("eccentricity", [&](const JsonValue& v) { f.eccentricity = v.numberF(kAny); });
+    set("caustic_width",
+        [&](const JsonValue& v) { f.causticWidth = radians(v.numberF(kDegrees)); });
+    set("caustic_gain", [&](const JsonValue& v) { f.causticGain = v.numberF(kAny); });
+    set("caustic_fade", [&](const JsonValue& v) { f.causticFade = v.numberF(kAny); });
+    set("caustic_max_width", [&](const JsonValue& v) { f.causticMaxWidth = v.numberF(kAny); });
+    obj.finish();
+}
+
+DualScatteringParams parseDualScattering(JsonObject obj) {
+    DualScatteringParams d;
+    for (const char* key : {"d_f", "d_b"}) {
+        const JsonValue v = obj[key];
+        if (!v.present())
+            continue;
+        (key[2] == 'f' ? d.d_f : d.d_b) = v.numberF(kAny);
+        checkAt(v, [&] { d.validate(); });
+    }
+    obj.finish();
+    return d;
+}
+
+// --- lights, camera, head ----------------------------------------------------
+
+Light parseLight(JsonObject obj, std::size_t index) {
+    Light light;
+    light.name = strCat("light", index);
+    if (const JsonValue v = obj["name"]; v.present()) {
+        light.name = v.string();
+        if (!isValidLightName(light.name))
+            v.failExpected(kLightNameRule);
+    }
+    const Light::Kind kind =
+        obj.required("type", "\"directional\" or \"point\"").oneOf(kLightKindNames);
+    if (kind == Light::Kind::Directional) {
+        const JsonValue v = obj.required("direction", "a vector toward the light");
+        const Vec3f d = v.vec3(kCoordinate);
+        if (!(glm::length(d) > 0))
+            v.failExpected("a non-zero vector from the scene toward the light");
+        light.kind = Light::Kind::Directional;
+        light.direction = glm::normalize(d);
+    } else {
+        light.kind = Light::Kind::Point;
+        light.position = obj.required("position", "the light's position").vec3(kCoordinate);
+    }
+    if (const JsonValue v = obj["color"]; v.present())
+        light.color = v.rgb(kLightColor);
+    if (const JsonValue v = obj["intensity"]; v.present())
+        light.intensity = v.numberF(kLightIntensity);
+    obj.finish();
+    return light;
+}
+
+CameraParams parseCamera(JsonObject obj) {
+    CameraParams c;
+    c.position = obj.required("position", "an array of 3 numbers").vec3(kCoordinate);
+    c.lookAt = obj.required("look_at", "an array of 3 numbers").vec3(kCoordinate);
+    if (const JsonValue v = obj["up"]; v.present())
+        c.up = v.vec3(kCoordinate);
+    if (const JsonValue v = obj["fov"]; v.present())
+        c.fovY = v.numberF(kFovDegrees);
+    if (const JsonValue v = obj["resolution"]; v.present()) {
+        const std::vector<JsonValue> wh = v.array(2, 2);
+        c.width = static_cast<std::uint32_t>(wh[0].integer(1, kMaxResolution));
+        c.height = static_cast<std::uint32_t>(wh[1].integer(1, kMaxResolution));
+        if (std::uint64_t(c.width) * c.height > kMaxPixels)
+            v.fail(strCat(c.width, " x ", c.height, ": expected at most ", kMaxPixels, " pixels"));
+    }
+    obj.finish();
+    checkAt(obj, [&] { Camera camera(c); });
+    return c;
+}
+
+Head parseHead(JsonObject obj) {
+    Head h;
+    if (const JsonValue v = obj["center"]; v.present())
+        h.sphere.center = v.vec3(kCoordinate);
+    if (const JsonValue v = obj["radius"]; v.present())
+        h.sphere.radius = v.numberF(kHeadRadius);
+    if (const JsonValue v = obj["color"]; v.present())
+        h.albedo = v.rgb(kAlbedo);
+    obj.finish();
+    return h;
+}
+
+std::filesystem::path parseOutputPath(const JsonValue& v, const std::filesystem::path& fallback) {
+    if (!v.present())
+        return fallback;
+    if (v.isNull())
+        return {};
+    const std::string s = v.string();
+    if (s.empty() || s.back() == '/')
+        v.failExpected("a file path or null (not written)");
+    return s;
+}
+
+OutputSettings parseOutput(JsonObject obj, const std::string& stem) {
+    OutputSettings o;
+    o.exr = parseOutputPath(obj["exr"], std::filesystem::path("out") / (stem + ".exr"));
+    o.png = parseOutputPath(obj["png"], std::filesystem::path("out") / (stem + ".png"));
+    if (const JsonValue v = obj["exposure"]; v.present())
+        o.exposure = v.numberF(kExposure);
+    if (const JsonValue v = obj["tone_map"]; v.present())
+        o.toneMap = v.oneOf(kToneMapNames);
+    obj.finish();
+    return o;
+}
+
+} // namespace
+
+void Scene::validate() const {
+    if (groom.isProcedural()) {
+        groom.procedural.validate();
+        if (std::uint64_t(groom.procedural.strands) * groom.procedural.resolvedPointsPerStrand() >
+            kMaxProceduralPoints)
+            throw InputError(
+                strCat("groom.procedural: more than ", kMaxProceduralPoints, " points"));
+    }
+    fiberScale.validate();
+    fiber.validate();
+    dualScattering.validate();
+
+    if (lights.size() > kMaxLights)
+        throw InputError(strCat(lights.size(), " lights: expected at most ", kMaxLights));
+    for (std::size_t i = 0; i < lights.size(); ++i) {
+        const Light& l = lights[i];
+        const std::string field = strCat("lights[", i, "]");
+        if (!isValidLightName(l.name))
+            throw InputError(strCat(field, ".name \"", l.name, "\": expected ", kLightNameRule));
+        for (std::size_t j = 0; j < i; ++j)
+            if (lights[j].name == l.name)
+                throw InputError(strCat(field, ".name \"", l.name, "\": used by lights[", j,
+                                        "] too; light names must be unique"));
+        if (l.kind == Light::Kind::Directional) {
+            if (!isFinite(l.direction) || std::abs(glm::length(l.direction) - 1.0f) > 1e-4f)
+                throw InputError(strCat(field, ".direction: expected a unit vector"));
+        } else {
+            requireInRange(field + ".position", l.position, kCoordinate);
+        }
+        requireInRange(field + ".color", l.color, kLightColor);
+        requireInRange(field + ".intensity", l.intensity, kLightIntensity);
+    }
+
+    const Camera cam(camera); // checks the frame, field of view and resolution
+    if (head) {
+        requireInRange("head.center", head->sphere.center, kCoordinate);
+        requireInRange("head.radius", head->sphere.radius, kHeadRadius);
+        requireInRange("head.color", head->albedo, kAlbedo);
+        if (glm::distance(camera.position, head->sphere.center) <= head->sphere.radius)
+            throw InputError("camera.position is inside the head sphere");
+    }
+    if (voxelSize)
+        requireInRange("grid.voxel_size", *voxelSize, kVoxelSize);
+    if (exact.rays < 1 || exact.rays > kMaxExactRays)
+        throw InputError(strCat("global_term.exact.rays = ", exact.rays,
+                                ": expected an integer in [1, ", kMaxExactRays, "]"));
+    requireInRange("global_term.exact.radius", exact.radius, kExactRadius);
+    requireInRange("background", background, kBackground);
+    requireInRange("output.exposure", output.exposure, kExposure);
+}
+
+Scene parseScene(const nlohmann::json& document, const std::string& sourceName,
+                 const std::filesystem::path& baseDir) {
+    Scene scene;
+    scene.name = sourceName;
+    JsonObject root = JsonValue(&document, "", sourceName).object();
+
+    scene.groom = parseGroom(root.required("groom", "an object").object(), baseDir);
+    if (const JsonValue v = root["fiber"]; v.present())
+        parseFiber(v.object(), scene);
+    if (const JsonValue v = root["dual_scattering"]; v.present())
+        scene.dualScattering = parseDualScattering(v.object());
+
+    const JsonValue lights = root.required("lights", "an array of lights");
+    for (const JsonValue& l : lights.array(0, kMaxLights))
+        scene.lights.push_back(parseLight(l.object(), scene.lights.size()));
+    for (std::size_t i = 0; i < scene.lights.size(); ++i)
+        for (std::size_t j = 0; j < i; ++j)
+            if (scene.lights[i].name == scene.lights[j].name)
+                lights.fail(strCat("lights ", j, " and ", i, " are both named \"",
+                                   scene.lights[i].name, "\"; light names must be unique"));
+
+    scene.camera = parseCamera(root.required("camera", "an object").object());
+    if (const JsonValue v = root["head"]; v.present() && !v.isNull())
+        scene.head = parseHead(v.object());
+
+    if (const JsonValue v = root["grid"]; v.present()) {
+        JsonObject grid = v.object();
+        if (const JsonValue s = grid["voxel_size"]; s.present() && !s.isString())
+            scene.voxelSize = s.numberF(kVoxelSize);
+        else if (s.present() && s.string() != "auto")
+            s.failExpected(strCat("\"auto\" or a number ", kVoxelSize.describe()));
+        grid.finish();
+    }
+    if (const JsonValue v = root["global_term"]; v.present()) {
+        JsonObject gt = v.object();
+        if (const JsonValue m = gt["mode"]; m.present())
+            scene.globalTermMode = m.oneOf(kGlobalTermModeNames);
+        if (const JsonValue e = gt["exact"]; e.present()) {
+            JsonObject exact = e.object();
+            if (const JsonValue r = exact["rays"]; r.present())
+                scene.exact.rays = static_cast<std::uint32_t>(r.integer(1, kMaxExactRays));
+            if (const JsonValue r = exact["radius"]; r.present())
+                scene.exact.radius = r.numberF(kExactRadius);
+            exact.finish();
+        }
+        gt.finish();
+    }
+    if (const JsonValue v = root["shading_rate"]; v.present())
+        scene.shadingRate = v.oneOf(kShadingRateNames);
+    if (const JsonValue v = root["background"]; v.present())
+        scene.background = v.rgb(kBackground);
+
+    const std::string stem = std::filesystem::path(sourceName).stem().string();
+    const nlohmann::json noOutput = nlohmann::json::object();
+    const JsonValue output = root["output"];
+    scene.output = parseOutput(output.present() ? output.object()
+                                                : JsonObject(noOutput, "/output", sourceName),
+                               stem.empty() ? "render" : stem);
+    root.finish();
+
+    try {
+        scene.validate();
+    } catch (const InputError& e) {
+        throw InputError(strCat(sourceName, ": ", e.what()));
+    }
+    return scene;
+}
+
+Scene parseSceneText(std::string_view text, const std::string& sourceName,
+                     const std::filesystem::path& baseDir) {
+    nlohmann::json document;
+    try {
+        document = nlohmann::json::parse(text.begin(), text.end());
+    } catch (const nlohmann::json::exception& e) {
+        // e.what() reads "[json.exception.parse_error.101] parse error at line 3, column 5: ...";
+        // a number too large for a double is an out_of_range.406 from the parser.
+        const std::string what = e.what();
+        const std::size_t at = what.find("] ");
+        throw InputError(strCat(
+            sourceName, ": invalid JSON: ", at == std::string::npos ? what : what.substr(at + 2)));
+    }
+    return parseScene(document, sourceName, baseDir);
+}
+
+Scene loadScene(const std::filesystem::path& path) {
+    std::error_code ec;
+    const std::uintmax_t size = std::filesystem::file_size(path, ec);
+    if (ec)
+        throw InputError(strCat(path.string(), ": cannot read scene file: ", ec.message()));
+    if (size > kMaxSceneFileBytes)
+        throw InputError(strCat(path.string(), ": ", size, " bytes: a scene file is at most ",
+                                kMaxSceneFileBytes, " bytes"));
+    std::ifstream in(path, std::ios::binary);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (!in && !in.eof())
+        throw InputError(strCat(path.string(), ": cannot read scene file"));
+    return parseSceneText(text, path.string(), path.parent_path());
+}
+
+std::ostream& operator<<(std::ostream& os, const Scene& s) {
+    os << "Scene(" << s.name << ": groom=";
+    if (s.groom.isProcedural())
+        os << s.groom.procedural;
+    else
+        os << s.groom.file.string();
+    os << ", " << s.fiberScale << ", " << s.fiber << ", " << s.dualScattering << ", "
+       << s.lights.size() << " lights";
+    for (const Light& l : s.lights)
+        os << " " << l;
+    os << ", " << s.camera;
+    if (s.head)
+        os << ", head(center=" << s.head->sphere.center << ", r=" << s.head->sphere.radius
+           << ", albedo=" << s.head->albedo << ")";
+    os << ", mode=" << s.globalTermMode
+       << ", voxel=" << (s.voxelSize ? strCat(*s.voxelSize) : std::string("auto"))
+       << ", exact(rays=" << s.exact.rays << ", r=" << s.exact.radius << "), rate=" << s.shadingRate
+       << ", background=" << s.background << ", exr='" << s.output.exr.string() << "', png='"
+       << s.output.png.string() << "', exposure=" << s.output.exposure
+       << ", tone_map=" << toString(s.output.toneMap) << ")";
+    return os;
+}
+
+} // namespace hairvox

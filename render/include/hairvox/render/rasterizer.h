@@ -1,0 +1,122 @@
+// hairvox render: the hair rasterizer — strands as ribbons, exact coverage,
+// front-to-back compositing, deferred shading through a FragmentShader.
+//
+// Strands are drawn as camera-facing ribbons of the fiber diameter D (world
+// units, usually far below a pixel). Each segment becomes a quad whose edges
+// at a vertex are offset by ±D/2 perpendicular to that vertex's projected
+// tangent, so consecutive segments share an edge (no gaps, no overlaps).
+// Coverage is analytic: the exact area of quad ∩ pixel square (box filter),
+// so thin hair neither aliases nor sparkles (ribbon.h).
+//
+// Per pixel, fragments are composited front to back in depth order (ties
+// broken by segment index); fragments of adjacent segments of one strand that
+// follow each other add their coverage (they tile the ribbon) instead of
+// compositing over each other. A strand standing for k hairs (the density
+// multiplier, strands/fiber_scale.h) that covers α of a pixel transmits
+// (1 − α)^k — k hairs at independent positions, as the global term counts
+// them. A pixel is opaque once its transmittance falls to
+// RasterSettings::opaqueTransmittance: fragments behind it are never shaded,
+// and since segments are rasterized nearest first, most of them are not even
+// generated (docs/DESIGN.md §7).
+//
+// Opaque surfaces (the head, meshes) are not drawn here: the caller gives
+// them as a SurfaceLayer — per pixel the coverage, depth and radiance of what
+// it found there — and each covered pixel gets one surface fragment,
+// composited with the hair. A tile whose every pixel is wholly covered by a
+// surface culls the segments that lie wholly behind its farthest surface
+// depth before they are rasterized.
+//
+// Work is done per 32×32 tile (segments binned to tiles, then raster,
+// composite and shade per tile) in parallel with TBB; memory beyond the film
+// is bounded by a few tiles per thread, and the film's bytes do not depend on
+// the thread count.
+//
+// The film (film/film.h) gets: the beauty "" and alpha "A"; the shader's
+// radiance layers; the surfaces' radiance (kSurfaceLayer) and the background
+// seen through everything (kBackgroundLayer) — all premultiplied, and
+//     beauty = Σ shader radiance layers + surface + background;
+// the hair's share of the alpha (kHairAlphaLayer); the depth (kDepthLayer,
+// camera-space z averaged with the compositing weights, 0 where empty); and
+// the shader's average layers.
+#pragma once
+
+#include <hairvox/core/rgb.h>
+#include <hairvox/film/film.h>
+#include <hairvox/geometry/camera.h>
+#include <hairvox/render/fragment_shader.h>
+#include <hairvox/strands/fiber_scale.h>
+#include <hairvox/strands/groom.h>
+
+#include <cstdint>
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace hairvox {
+
+inline constexpr const char* kSurfaceLayer = "head";
+inline constexpr const char* kBackgroundLayer = "background";
+inline constexpr const char* kHairAlphaLayer = "hair.A";
+inline constexpr const char* kDepthLayer = "Z";
+
+/// Opaque surfaces as the camera sees them, per pixel (row-major, the
+/// camera's resolution): the fraction of the pixel they cover, their mean
+/// camera depth there and their mean outgoing radiance. Empty: no surfaces.
+struct SurfaceLayer {
+    std::vector<float> coverage; ///< [0, 1]; 0 where no surface
+    std::vector<float> depth;
+    std::vector<Rgb> radiance;
+
+    bool empty() const { return coverage.empty(); }
+};
+
+struct RasterSettings {
+    FiberScale fiberScale; ///< ribbons D wide; a strand's coverage counts k hairs
+    ShadingRate shadingRate = ShadingRate::Fragment;
+    Rgb background{0.0f}; ///< radiance behind everything
+    /// A pixel is opaque once its transmittance is ≤ this: fragments behind it
+    /// are skipped. Their share of the pixel is at most this value. [0, 1)
+    float opaqueTransmittance = 1.0f / 256.0f;
+    int threads = 0;       ///< 0: all cores
+    bool progress = false; ///< draw a progress bar on stderr (the caller checks it is a terminal)
+};
+
+struct RasterStats {
+    double seconds = 0;       ///< wall time of rasterize()
+    double setupSeconds = 0;  ///< vertex tangents, projection and binning (wall)
+    double rasterSeconds = 0; ///< raster, sort, composite (wall, apportioned by thread time)
+    double shadeSeconds = 0;  ///< shader calls and accumulation (wall, apportioned by thread time)
+    std::uint64_t segments = 0;
+    std::uint64_t segmentsOutsideView = 0; ///< off screen or behind the camera
+    std::uint64_t segmentTileRefs = 0;     ///< (segment, tile) pairs binned
+    /// (segment, tile) pairs culled: the segment lies behind a tile wholly covered by surfaces.
+    std::uint64_t segmentTilesBehindSurfaces = 0;
+    std::uint64_t segmentTilesSkipped =
+        0;                       ///< of those binned, skipped: the tile was already opaque
+    std::uint64_t fragments = 0; ///< hair (segment, pixel) pairs met
+    /// Of those, skipped behind an opaque pixel (never shaded; counted per
+    /// pixel of the ribbon's row span, coverage not computed).
+    std::uint64_t fragmentsBehindOpaque = 0;
+    std::uint64_t fragmentsComposited = 0; ///< hair fragments that reached the pixel
+    std::uint64_t shadingPoints = 0;       ///< points handed to the shader
+    std::uint64_t invalidSamples = 0;      ///< shader results rejected (NaN, Inf, negative)
+    std::uint64_t tiles = 0;
+};
+
+std::ostream& operator<<(std::ostream& os, const RasterStats& s);
+
+struct RasterOutput {
+    Film film;
+    RasterStats stats;
+    /// Human-readable notes (the first rejected shader results, pbrt-v4 style).
+    std::vector<std::string> warnings;
+};
+
+/// Rasterizes `groom` as the camera sees it, shaded by `shader`, over the
+/// opaque `surfaces` (empty: none). Polls throwIfInterrupted() between tiles
+/// and shader batches. Throws InputError for invalid settings or a surface
+/// layer of the wrong size; segments with non-finite projections are culled.
+RasterOutput rasterize(const Groom& groom, const Camera& camera, const FragmentShader& shader,
+                       const RasterSettings& settings, const SurfaceLayer& surfaces = {});
+
+} // namespace hairvox

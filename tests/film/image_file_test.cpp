@@ -1,0 +1,206 @@
+// The film and its files (film/): layers round-trip through EXR at the
+// precision each is stored with, the PNG is the tone-mapped preview, and a
+// failed or interrupted write leaves nothing behind.
+#include "test_util.h"
+
+#include <hairvox/core/error.h>
+#include <hairvox/core/interrupt.h>
+#include <hairvox/core/parallel.h>
+#include <hairvox/core/rng.h>
+#include <hairvox/film/image_compare.h>
+#include <hairvox/film/image_file.h>
+
+#include <gtest/gtest.h>
+#include <png.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <thread>
+
+namespace hairvox {
+namespace {
+
+/// A film of pseudo-random layers: a beauty, an RGB layer, a scalar and a
+/// full-precision scalar (depth-like).
+Film randomFilm(int width, int height, std::uint64_t seed) {
+    Film film(width, height);
+    Pcg32 rng(seed);
+    for (const auto& [name, channels, full] :
+         {std::tuple{std::string(Film::kBeauty), 3, false}, std::tuple{std::string("A"), 1, false},
+          std::tuple{std::string("direct_R"), 3, false}, std::tuple{std::string("key.V"), 1, false},
+          std::tuple{std::string("Z"), 1, true}}) {
+        FilmLayer& layer = film.layer(film.addLayer(name, channels, full));
+        for (float& x : layer.data)
+            x = full ? 1.0f + rng.uniformFloat() : rng.uniformFloat();
+    }
+    return film;
+}
+
+TEST(Film, LayersAreNamedOnceAndSized) {
+    Film film(4, 3);
+    EXPECT_EQ(film.addLayer("x", 3), 0u);
+    EXPECT_EQ(film.addLayer("y", 1), 1u);
+    EXPECT_EQ(film.layer("x").data.size(), 36u);
+    EXPECT_EQ(film.layer("y").data.size(), 12u);
+    EXPECT_THROW(film.addLayer("x", 1), std::invalid_argument);
+    EXPECT_THROW(film.addLayer("z", 2), std::invalid_argument);
+    EXPECT_THROW(static_cast<void>(film.layer("missing")), std::out_of_range);
+    EXPECT_FALSE(film.find("missing"));
+}
+
+TEST(ExrFile, EveryLayerRoundTripsAtItsPrecision) {
+    const Film film = randomFilm(37, 23, 5);
+    test::TempDir dir;
+    ExrHeader header;
+    header.attributes = {{"hairvox:note", "test"}};
+    header.worldToCamera = Matrix44{{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {2, 3, 4, 1}}};
+    writeExr(dir / "image.exr", film, header);
+    const ExrImage exr = readExr(dir / "image.exr");
+    EXPECT_EQ(exr.width, 37);
+    EXPECT_EQ(exr.height, 23);
+    EXPECT_EQ(exr.attributes.at("hairvox:note"), "test");
+    EXPECT_EQ(exr.attributes.at("software"), "hairvox");
+    const char* rgb[3] = {"R", "G", "B"};
+    EXPECT_EQ(exr.channels.size(), 3u + 1u + 3u + 1u + 1u);
+    for (std::size_t p = 0; p < film.pixelCount(); ++p) {
+        for (int c = 0; c < 3; ++c) {
+            // Half: 11-bit mantissa, relative error ≤ 2^-11 in [0.5, 1), absolute below.
+            ASSERT_NEAR(exr.channels.at(rgb[c])[p], film.beauty(p)[c], 5e-4f);
+            ASSERT_NEAR(exr.channels.at(std::string("direct_R.") + rgb[c])[p],
+                        film.layer("direct_R").rgb(p)[c], 5e-4f);
+        }
+        ASSERT_NEAR(exr.channels.at("key.V")[p], film.layer("key.V").scalar(p), 5e-4f);
+        ASSERT_EQ(exr.channels.at("Z")[p], film.layer("Z").scalar(p)); // 32-bit float, exact
+    }
+}
+
+TEST(ExrFile, BytesDoNotDependOnTheThreadCount) {
+    const Film film = randomFilm(80, 60, 7);
+    test::TempDir dir;
+    auto bytes = [&](int threads) {
+        const ThreadLimit limit(threads);
+        const auto path = dir / strCat("t", threads, ".exr");
+        writeExr(path, film);
+        std::ifstream in(path, std::ios::binary);
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    };
+    const std::string one = bytes(1);
+    EXPECT_GT(one.size(), 1000u);
+    EXPECT_EQ(bytes(2), one);
+    EXPECT_EQ(bytes(4), one);
+}
+
+TEST(ExrFile, KeepsValuesBeyondHalfRange) {
+    Film film(4, 2);
+    film.addLayer(std::string(Film::kBeauty), 3);
+    film.layer(Film::kBeauty).data[9] = 1e6f;
+    test::TempDir dir;
+    writeExr(dir / "bright.exr", film);
+    const ExrImage exr = readExr(dir / "bright.exr");
+    EXPECT_EQ(exr.channels.at("R")[3], 1e6f); // float, not Inf
+}
+
+TEST(PngFile, IsTheTonemappedPreview) {
+    const Film film = randomFilm(80, 60, 9);
+    test::TempDir dir;
+    const std::vector<std::uint8_t> preview = previewPixels(film, 0.5f, ToneMap::Filmic);
+    writePng(dir / "preview.png", film.width(), film.height(), preview);
+    png_image image{};
+    image.version = PNG_IMAGE_VERSION;
+    ASSERT_TRUE(png_image_begin_read_from_file(&image, (dir / "preview.png").c_str()));
+    EXPECT_EQ(image.width, 80u);
+    EXPECT_EQ(image.height, 60u);
+    image.format = PNG_FORMAT_RGB;
+    std::vector<std::uint8_t> pixels(PNG_IMAGE_SIZE(image));
+    ASSERT_TRUE(png_image_finish_read(&image, nullptr, pixels.data(), 0, nullptr));
+    EXPECT_EQ(pixels, preview);
+}
+
+TEST(PngFile, ToneMapsAreMonotoneAndDocumented) {
+    Film film(5, 1);
+    film.addLayer(std::string(Film::kBeauty), 3);
+    const float values[5] = {0.0f, 0.0031308f, 0.18f, 1.0f, 100.0f};
+    for (std::size_t i = 0; i < 5; ++i)
+        for (std::size_t c = 0; c < 3; ++c)
+            film.layer(Film::kBeauty).data[3 * i + c] = values[i];
+    const std::vector<std::uint8_t> clamp = previewPixels(film, 0.0f, ToneMap::Clamp);
+    EXPECT_EQ(clamp[0], 0);
+    EXPECT_EQ(clamp[3], 10);  // 12.92 · 0.0031308 · 255 = 10.3
+    EXPECT_EQ(clamp[6], 118); // sRGB(0.18) = 0.461
+    EXPECT_EQ(clamp[9], 255);
+    const std::vector<std::uint8_t> filmic = previewPixels(film, 0.0f, ToneMap::Filmic);
+    for (int i = 1; i < 5; ++i)
+        EXPECT_GE(filmic[std::size_t(i) * 3], filmic[std::size_t(i - 1) * 3]);
+    EXPECT_LT(filmic[9], 255); // highlights roll off instead of clipping at 1
+    EXPECT_EQ(filmic[12], 255);
+    const std::vector<std::uint8_t> brighter = previewPixels(film, 1.0f, ToneMap::Clamp);
+    EXPECT_GT(brighter[6], clamp[6]);
+}
+
+int filesIn(const std::filesystem::path& dir) {
+    int files = 0;
+    for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator(dir))
+        ++files;
+    return files;
+}
+
+std::string firstLine(const std::filesystem::path& path) {
+    std::ifstream in(path);
+    std::string text;
+    std::getline(in, text);
+    return text;
+}
+
+TEST(PngFile, FailedWritesLeaveNoFileAndKeepTheOldOne) {
+    test::TempDir dir;
+    const auto png = dir / "keep.png";
+    test::writeText(png, "previous image");
+    // libpng refuses a 0×0 image inside the writer.
+    EXPECT_THROW(writePng(png, 0, 0, {}), InputError);
+    EXPECT_EQ(firstLine(png), "previous image");
+    EXPECT_THROW(writePng(dir / "new.png", 0, 0, {}), InputError);
+    EXPECT_FALSE(std::filesystem::exists(dir / "new.png"));
+    EXPECT_EQ(filesIn(dir.path()), 1); // no temporary left behind
+    EXPECT_THROW(readExr(dir / "keep.png"), InputError);
+}
+
+// Regression (issue 8, Ctrl-C latency): the EXR writer polls for interruption
+// between bands and lets Interrupted through. The interrupt arrives while the
+// file is being written — the temporary exists — so the test fails if the
+// writer does not stop, or stops without cleaning up, or never started.
+TEST(ExrFile, InterruptedWriteLeavesTheOldFile) {
+    const Film film = randomFilm(1024, 2048, 11); // seconds of compression on one thread
+    test::TempDir dir;
+    const auto path = dir / "keep.exr";
+    test::writeText(path, "previous image");
+    std::atomic<bool> done{false}, sawTemporary{false};
+    std::thread interrupter([&] {
+        while (!done) {
+            if (filesIn(dir.path()) > 1) { // the writer's temporary is there
+                sawTemporary = true;
+                requestInterrupt();
+                return;
+            }
+            std::this_thread::sleep_for(std::chrono::microseconds(200));
+        }
+    });
+    const ThreadLimit oneThread(1);
+    bool interrupted = false;
+    try {
+        writeExr(path, film);
+    } catch (const Interrupted&) {
+        interrupted = true;
+    }
+    done = true;
+    interrupter.join();
+    clearInterrupt();
+    ASSERT_TRUE(sawTemporary) << "the write finished before the interrupt could arrive";
+    EXPECT_TRUE(interrupted);
+    EXPECT_EQ(firstLine(path), "previous image");
+    EXPECT_EQ(filesIn(dir.path()), 1); // no temporary left behind
+}
+
+} // namespace
+} // namespace hairvox
