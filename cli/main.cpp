@@ -37,8 +37,8 @@ int main(int argc, char** argv) {
     } catch (const hairvox::InputError& e) {
         std::fprintf(stderr, "hairvox: error: %s\n", e.what());
         return 2;
-    } catch (const hairvox::Interrupted&) {
-        std::fprintf(stderr, "hairvox: interrupted; no partial output was written\n");
+    } catch (const hairvox::Interrupted& e) {
+        std::fprintf(stderr, "hairvox: %s\n", e.what());
         return 130;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "hairvox: internal error: %s\n", e.what());

@@ -1,5 +1,9 @@
 #include <hairvox/core/parallel.h>
 
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#endif
+
 #include <tbb/global_control.h>
 
 #include <cstddef>
@@ -18,6 +22,13 @@ ThreadLimit::ThreadLimit(int threads) : impl_(std::make_unique<Impl>()) {
 }
 
 ThreadLimit::~ThreadLimit() = default;
+
+void flushDenormalsToZero() {
+#if defined(__SSE__)
+    constexpr unsigned kFlushToZero = 0x8000, kDenormalsAreZero = 0x0040;
+    _mm_setcsr(_mm_getcsr() | kFlushToZero | kDenormalsAreZero);
+#endif
+}
 
 int activeThreadCount() {
     return static_cast<int>(

@@ -177,4 +177,40 @@ ExrImage readExr(const std::filesystem::path& path) {
     }
 }
 
+Film filmFromExr(const ExrImage& image) {
+    Film film(image.width, image.height);
+    const auto has = [&](const std::string& name) { return image.channels.count(name) > 0; };
+    // The layers whose R, G and B channels are all present; a channel of none is a scalar.
+    std::map<std::string, bool> rgbLayer;
+    for (const auto& [name, values] : image.channels) {
+        const std::size_t dot = name.rfind('.');
+        const std::string layer = dot == std::string::npos ? "" : name.substr(0, dot);
+        const std::string prefix = layer.empty() ? "" : layer + ".";
+        if (name == prefix + "R" || name == prefix + "G" || name == prefix + "B")
+            rgbLayer[layer] = has(prefix + "R") && has(prefix + "G") && has(prefix + "B");
+    }
+    for (const auto& [name, values] : image.channels) {
+        const std::size_t dot = name.rfind('.');
+        const std::string layer = dot == std::string::npos ? "" : name.substr(0, dot);
+        const std::string channel = dot == std::string::npos ? name : name.substr(dot + 1);
+        const auto rgb = rgbLayer.find(layer);
+        if (rgb != rgbLayer.end() && rgb->second && (channel == "R" || channel == "G" || channel == "B")) {
+            if (film.find(layer))
+                continue;
+            const std::string prefix = layer.empty() ? "" : layer + ".";
+            FilmLayer& l = film.layer(film.addLayer(layer, 3, true));
+            const std::vector<float>&r = image.channels.at(prefix + "R"), &g = image.channels.at(prefix + "G"),
+                                     &b = image.channels.at(prefix + "B");
+            for (std::size_t p = 0; p < film.pixelCount(); ++p) {
+                l.data[3 * p] = r[p];
+                l.data[3 * p + 1] = g[p];
+                l.data[3 * p + 2] = b[p];
+            }
+            continue;
+        }
+        film.layer(film.addLayer(name, 1, true)).data = values;
+    }
+    return film;
+}
+
 } // namespace hairvox

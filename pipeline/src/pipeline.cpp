@@ -3,6 +3,7 @@
 
 #include <hairvox/core/error.h>
 #include <hairvox/core/format.h>
+#include <hairvox/core/hash.h>
 #include <hairvox/core/interrupt.h>
 #include <hairvox/core/parallel.h>
 #include <hairvox/film/image_file.h>
@@ -11,6 +12,7 @@
 #include <hairvox/transmittance/exact_global_term.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <cstdio>
 #include <sstream>
 
@@ -111,9 +113,10 @@ std::unique_ptr<SceneAssets> loadSceneAssets(const Scene& scene, const PipelineO
     return assets;
 }
 
-SceneRender renderScene(const Scene& scene, const PipelineOptions& options, bool writeFiles) {
-    scene.validate();
-    const ThreadLimit threadLimit(options.threads);
+namespace {
+
+SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& options,
+                                 bool writeFiles) {
     SceneRender result;
     const std::unique_ptr<SceneAssets> assets = loadSceneAssets(scene, options);
     result.times = assets->times;
@@ -153,12 +156,15 @@ SceneRender renderScene(const Scene& scene, const PipelineOptions& options, bool
     const SurfaceLayer surfaces =
         scene.head ? detail::headSurfaceLayer(*scene.head, camera, scene.lights) : SurfaceLayer{};
     const double surfaceSeconds = secondsSince(surfacesStart);
-    result.image =
+    RasterOutput image =
         rasterize(assets->groom, camera, fragmentShader, rasterSettings(scene, options), surfaces);
+    result.film = std::move(image.film);
+    result.raster = image.stats;
+    result.warnings = std::move(image.warnings);
 
     // The renderer's shading time includes the global-term evaluations made
     // inside the shader: apportion it by the shader's own thread time.
-    const RasterStats& st = result.image.stats;
+    const RasterStats& st = *result.raster;
     const double shaderThread = fragmentShader.shadeThreadSeconds();
     const double evalShare =
         shaderThread > 0 ? fragmentShader.globalTermThreadSeconds() / shaderThread : 0.0;
@@ -174,10 +180,125 @@ SceneRender renderScene(const Scene& scene, const PipelineOptions& options, bool
         std::map<std::string, std::string> attributes;
         if (assets->grid)
             attributes["hairvox:voxel_size"] = std::to_string(assets->grid->info.voxelSize);
-        result.written = writeOutputs(result.image.film, scene, attributes);
+        result.written = writeOutputs(result.film, scene, attributes);
         result.times.write = secondsSince(start);
     }
     return result;
+}
+
+SceneRender renderPathTraced(const Scene& scene, const PipelineOptions& options,
+                             bool writeFiles) {
+    SceneRender result;
+    auto start = Clock::now();
+    std::string groomWarnings;
+    const Groom groom = loadGroom(scene, groomWarnings);
+    if (!groomWarnings.empty())
+        result.warnings.push_back(groomWarnings);
+    result.times.load = secondsSince(start);
+    const std::string hash = pathTraceHash(scene, groom);
+
+    // Continue from the scene's own earlier output, if asked and it is there.
+    std::optional<Film> previous;
+    std::uint32_t previousSpp = 0;
+    if (options.continuePathTrace && !scene.output.exr.empty() &&
+        std::filesystem::exists(scene.output.exr)) {
+        const ExrImage exr = readExr(scene.output.exr);
+        const auto attribute = [&](const char* key) -> std::string {
+            const auto it = exr.attributes.find(key);
+            return it == exr.attributes.end() ? std::string() : it->second;
+        };
+        const std::string& file = scene.output.exr.string();
+        if (attribute("hairvox:integrator") != toString(Integrator::Path))
+            throw InputError(strCat(file, ": not a path-traced image; cannot continue it"));
+        if (attribute("hairvox:pathTraceHash") != hash)
+            throw InputError(strCat(file, ": rendered from another scene, groom or seed (render hash ",
+                                    attribute("hairvox:pathTraceHash"), ", this scene's ", hash,
+                                    "); not continued"));
+        const std::string spp = attribute("hairvox:spp");
+        char* end = nullptr;
+        const unsigned long n = std::strtoul(spp.c_str(), &end, 10);
+        if (spp.empty() || *end != '\0' || n < 1 || n > 1'000'000)
+            throw InputError(strCat(file, ": hairvox:spp = \"", spp, "\": not a sample count"));
+        previousSpp = static_cast<std::uint32_t>(n);
+        previous = filmFromExr(exr);
+    }
+
+    PathTraceScene pts;
+    pts.groom = &groom;
+    pts.fiberScale = scene.fiberScale;
+    pts.fiber = scene.fiber;
+    pts.lights = scene.lights;
+    pts.camera = scene.camera;
+    if (scene.head)
+        pts.spheres.push_back({scene.head->sphere, scene.head->albedo});
+    pts.background = scene.background;
+    PathTraceSettings settings = scene.pathTrace;
+    settings.threads = options.threads;
+    settings.progress = options.progress;
+    start = Clock::now();
+    PathTraceOutput traced = pathTrace(pts, settings, previous ? &*previous : nullptr, previousSpp);
+    result.times.trace = secondsSince(start);
+    result.film = std::move(traced.film);
+    result.pathTrace = traced.stats;
+    for (const Light& light : scene.lights)
+        result.lights.push_back({light.name, light.isDark(), 0.0, {}});
+
+    if (writeFiles && traced.stats.spp > previousSpp) {
+        start = Clock::now();
+        result.written = writeOutputs(result.film, scene,
+                                      {{"hairvox:spp", std::to_string(traced.stats.spp)},
+                                       {"hairvox:seed", std::to_string(scene.pathTrace.seed)},
+                                       {"hairvox:pathTraceHash", hash}});
+        result.times.write = secondsSince(start);
+    }
+    return result;
+}
+
+} // namespace
+
+SceneRender renderScene(const Scene& scene, const PipelineOptions& options, bool writeFiles) {
+    scene.validate();
+    const ThreadLimit threadLimit(options.threads);
+    return scene.integrator == Integrator::Path ? renderPathTraced(scene, options, writeFiles)
+                                                : renderDualScattering(scene, options, writeFiles);
+}
+
+std::vector<std::string> hairRadianceLayers(const Film& film) {
+    std::vector<std::string> layers = {"direct_R", "direct_TT", "direct_TRT"};
+    if (film.find("multiple")) {
+        layers.emplace_back("multiple");
+    } else if (film.find("back_direct") && film.find("scatter")) {
+        layers.emplace_back("back_direct");
+        layers.emplace_back("scatter");
+    } else {
+        throw std::out_of_range("the image has neither the path tracer's layer 'multiple' nor the "
+                                "dual-scattering layers 'back_direct' and 'scatter'");
+    }
+    return layers;
+}
+
+ComparedImage hairRadianceOf(const Film& film) {
+    return ComparedImage::fromFilm(film, hairRadianceLayers(film), kHairAlphaLayer,
+                                   film.find("hair_half_a") ? "hair_half_a" : std::string_view{});
+}
+
+std::string pathTraceHash(const Scene& scene, const Groom& groom) {
+    Hasher h;
+    h.value(contentHash(groom));
+    scene.fiberScale.hashInto(h);
+    scene.fiber.hashInto(h);
+    for (const Light& l : scene.lights) {
+        h.value(l.kind).value(l.direction).value(l.position).value(l.color).value(l.intensity);
+        h.string(l.name);
+    }
+    const CameraParams& c = scene.camera;
+    h.value(c.position).value(c.lookAt).value(c.up).value(c.fovY).value(c.width).value(c.height);
+    h.value(scene.head.has_value());
+    if (scene.head)
+        h.value(scene.head->sphere.center).value(scene.head->sphere.radius).value(scene.head->albedo);
+    h.value(scene.background);
+    h.value(scene.pathTrace.seed).value(scene.pathTrace.maxDepth).value(scene.pathTrace.rouletteDepth);
+    return hexDigest(h.digest());
 }
 
 std::vector<std::filesystem::path> writeOutputs(const Film& film, const Scene& scene,
@@ -186,12 +307,14 @@ std::vector<std::filesystem::path> writeOutputs(const Film& film, const Scene& s
     if (!scene.output.exr.empty()) {
         ExrHeader header;
         header.worldToCamera = Camera(scene.camera).worldToCameraMatrix();
-        header.attributes = {
-            {"hairvox:scene", scene.name},
-            {"hairvox:globalTermMode", toString(scene.globalTermMode)},
-            {"hairvox:voxelSize", scene.voxelSize ? strCat(*scene.voxelSize) : "auto"},
-            {"hairvox:shadingRate", toString(scene.shadingRate)},
-        };
+        header.attributes = {{"hairvox:scene", scene.name},
+                             {"hairvox:integrator", toString(scene.integrator)}};
+        if (scene.integrator == Integrator::DualScattering) {
+            header.attributes["hairvox:globalTermMode"] = toString(scene.globalTermMode);
+            header.attributes["hairvox:voxelSize"] =
+                scene.voxelSize ? strCat(*scene.voxelSize) : "auto";
+            header.attributes["hairvox:shadingRate"] = toString(scene.shadingRate);
+        }
         for (const auto& [key, value] : extra)
             header.attributes[key] = value;
         writeExr(scene.output.exr, film, header);
@@ -206,16 +329,45 @@ std::vector<std::filesystem::path> writeOutputs(const Film& film, const Scene& s
 }
 
 void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& r) {
-    const RasterStats& st = r.image.stats;
     char line[512];
-    std::snprintf(line, sizeof(line), "hairvox: %s, %s mode, %dx%d: %.2f s\n", scene.name.c_str(),
-                  toString(scene.globalTermMode), scene.camera.width, scene.camera.height,
-                  r.times.total());
+    const Camera camera(scene.camera);
+    if (r.pathTrace)
+        std::snprintf(line, sizeof(line), "hairvox: %s, path traced, %dx%d: %.2f s\n",
+                      scene.name.c_str(), camera.width(), camera.height(), r.times.total());
+    else
+        std::snprintf(line, sizeof(line), "hairvox: %s, %s mode, %dx%d: %.2f s\n",
+                      scene.name.c_str(), toString(scene.globalTermMode), camera.width(),
+                      camera.height(), r.times.total());
     os << line;
     const auto row = [&](const char* stage, double seconds, const std::string& detail) {
         std::snprintf(line, sizeof(line), "  %-12s %7.3f s  %s\n", stage, seconds, detail.c_str());
         os << line;
     };
+    std::string written;
+    for (const auto& p : r.written)
+        written += (written.empty() ? "" : ", ") + p.string();
+    if (r.pathTrace) {
+        const PathTraceStats& pt = *r.pathTrace;
+        row("load", r.times.load, "the groom");
+        std::snprintf(line, sizeof(line),
+                      "%u spp (%u this run%s); %s paths, %s rays + %s shadow rays: %.2f M rays/s, "
+                      "%.3f M paths/s; %.1f scattering events per path, deepest %u",
+                      pt.spp, pt.sppThisRun,
+                      pt.interrupted ? ", interrupted" : (pt.timeLimited ? ", time limit" : ""),
+                      thousands(pt.paths).c_str(), thousands(pt.rays).c_str(),
+                      thousands(pt.shadowRays).c_str(), 1e-6 * pt.raysPerSecond(),
+                      1e-6 * pt.pathsPerSecond(),
+                      pt.paths > 0 ? double(pt.scatteringEvents) / double(pt.paths) : 0.0,
+                      pt.deepestPath);
+        row("trace", r.times.trace, line);
+        std::snprintf(line, sizeof(line), "%s paths stopped at the depth cap %u (throughput %.2g)",
+                      thousands(pt.pathsAtDepthCap).c_str(), scene.pathTrace.maxDepth,
+                      pt.energyAtDepthCap);
+        row("", 0.0, line);
+        row("write", r.times.write, written.empty() ? "nothing" : written);
+        return;
+    }
+    const RasterStats& st = *r.raster;
     row("load", r.times.load, thousands(st.segments) + " segments");
     if (r.voxelSize > 0) {
         std::snprintf(line, sizeof(line), "%s active voxels of %.3g",
@@ -244,9 +396,6 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
     row("shade", r.times.shade,
         thousands(st.shadingPoints) + " shading points; skipped " +
             thousands(st.fragmentsBehindOpaque) + " fragments behind opaque pixels");
-    std::string written;
-    for (const auto& p : r.written)
-        written += (written.empty() ? "" : ", ") + p.string();
     row("write", r.times.write, written.empty() ? "nothing" : written);
 }
 

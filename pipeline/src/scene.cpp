@@ -30,6 +30,7 @@ constexpr std::uint64_t kMaxExactRays = 65536;
 constexpr Range kExactRadius{0.0, 1000.0};
 constexpr Range kBackground{0.0, 1e6};
 constexpr Range kExposure{-20.0, 20.0};
+constexpr Range kTimeLimit{0.0, 1e7};
 constexpr Range kDegrees{-360.0, 360.0};
 constexpr Range kAny{-1e30, 1e30};
 constexpr std::size_t kMaxLightNameLength = 32;
@@ -328,6 +329,11 @@ void Scene::validate() const {
                                 ": expected an integer in [1, ", kMaxExactRays, "]"));
     requireInRange("global_term.exact.radius", exact.radius, kExactRadius);
     requireInRange("background", background, kBackground);
+    try {
+        pathTrace.validate();
+    } catch (const InputError& e) {
+        throw InputError(strCat("integrator: ", e.what()));
+    }
     requireInRange("output.exposure", output.exposure, kExposure);
 }
 
@@ -377,6 +383,37 @@ Scene parseScene(const nlohmann::json& document, const std::string& sourceName,
             exact.finish();
         }
         gt.finish();
+    }
+    if (const JsonValue v = root["integrator"]; v.present()) {
+        if (v.isString()) {
+            scene.integrator = v.oneOf(kIntegratorNames);
+        } else {
+            JsonObject in = v.object();
+            scene.integrator = in.required("type", "\"dual_scattering\" or \"path\"")
+                                   .oneOf(kIntegratorNames);
+            PathTraceSettings& pt = scene.pathTrace;
+            const auto set = [&](std::string_view key, auto assign) {
+                const JsonValue x = in[key];
+                if (!x.present())
+                    return;
+                if (scene.integrator != Integrator::Path)
+                    x.fail("applies to the path integrator only (\"type\": \"path\")");
+                assign(x);
+                checkAt(x, [&] { pt.validate(); });
+            };
+            set("spp", [&](const JsonValue& x) { pt.spp = static_cast<std::uint32_t>(x.integer(1, 1'000'000)); });
+            set("time_limit", [&](const JsonValue& x) { pt.timeLimit = x.number(kTimeLimit); });
+            set("max_depth", [&](const JsonValue& x) {
+                pt.maxDepth = static_cast<std::uint32_t>(x.integer(1, 100'000));
+            });
+            set("roulette_depth", [&](const JsonValue& x) {
+                pt.rouletteDepth = static_cast<std::uint32_t>(x.integer(1, 100'000));
+            });
+            set("seed", [&](const JsonValue& x) {
+                pt.seed = x.integer(0, std::numeric_limits<std::uint64_t>::max());
+            });
+            in.finish();
+        }
     }
     if (const JsonValue v = root["shading_rate"]; v.present())
         scene.shadingRate = v.oneOf(kShadingRateNames);

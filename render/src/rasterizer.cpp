@@ -37,9 +37,8 @@ double secondsSince(Clock::time_point start) {
 
 // --- geometry shared by all tiles ------------------------------------------
 
-/// Unit tangent at every point (the bisector of the adjacent segments'
-/// directions; a strand's end points take their one segment's), and every
-/// point's projection.
+/// Unit tangent at every point (strandTangents(): the bisector of the
+/// adjacent segments' directions), and every point's projection.
 void prepareVertices(const Groom& groom, const Camera& camera, float radius,
                      std::vector<Vec3f>& tangents,
                      std::vector<raster::ProjectedVertex>& projected) {
@@ -50,15 +49,8 @@ void prepareVertices(const Groom& groom, const Camera& camera, float radius,
         [&](const tbb::blocked_range<std::size_t>& range) {
             for (std::size_t s = range.begin(); s != range.end(); ++s) {
                 const std::size_t begin = groom.strandStart[s], end = groom.strandStart[s + 1];
-                Vec3f previous(0.0f);
-                for (std::size_t k = begin; k < end; ++k) {
-                    const Vec3f next =
-                        k + 1 < end
-                            ? normalizeOr(groom.points[k + 1] - groom.points[k], Vec3f(0.0f))
-                            : Vec3f(0.0f);
-                    tangents[k] = normalizeOr(previous + next, normalizeOr(next, previous));
-                    previous = next;
-                }
+                strandTangents({groom.points.data() + begin, end - begin},
+                               {tangents.data() + begin, end - begin});
                 const std::span<const Vec3f> points(groom.points.data() + begin, end - begin);
                 raster::projectStrand(camera, points, {tangents.data() + begin, end - begin},
                                       radius, camera.nearClip(),
@@ -603,8 +595,8 @@ private:
         const Vec3f& p1 = ctx_.groom.points[k + 1];
         ShadingPoint sp;
         sp.position = hairvox::lerp(t, p0, p1);
-        sp.tangent = normalizeOr(hairvox::lerp(t, ctx_.tangents[k], ctx_.tangents[k + 1]),
-                                 normalizeOr(p1 - p0, Vec3f(0.0f, 1.0f, 0.0f)));
+        sp.tangent = shadingTangent(ctx_.tangents[k], ctx_.tangents[k + 1], t,
+                                    normalizeOr(p1 - p0, Vec3f(0.0f, 1.0f, 0.0f)));
         sp.toCamera = normalizeOr(ctx_.camera.position() - sp.position, sp.tangent);
         sp.strand = s_.strandOf[local];
         sp.segment = k;

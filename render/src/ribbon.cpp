@@ -95,6 +95,27 @@ void projectStrand(const Camera& camera, std::span<const Vec3f> points,
                                      camera.directionToCamera(tangents[k]), focal, radius,
                                      fallback);
     }
+    // Miter joins: at an inner vertex the offset runs along the bent strand's
+    // bisector, so its projection onto each adjacent segment's normal — the
+    // ribbon's width there — is shorter by the cosine of half the bend.
+    // Lengthen it by that cosine's inverse (capped, like SVG's miter limit, at
+    // 4: a bend sharper than 150° keeps a shorter spike) so the ribbon is D wide
+    // along every segment and its area is D times its length.
+    constexpr double kMiterLimit = 4.0;
+    for (std::size_t k = 1; k + 1 < n; ++k) {
+        if (!out[k - 1].valid() || !out[k].valid() || !out[k + 1].valid())
+            continue;
+        const Vec2d o = out[k].offset;
+        const double len = glm::length(o);
+        const Vec2d a = out[k].raster - out[k - 1].raster, b = out[k + 1].raster - out[k].raster;
+        const double la = glm::length(a), lb = glm::length(b);
+        if (!(len > 0 && la > 1e-12 && lb > 1e-12))
+            continue;
+        // |o × d| / |o| is the cosine between the offset and the segment's normal.
+        const double ca = std::abs(o.x * a.y - o.y * a.x) / (len * la);
+        const double cb = std::abs(o.x * b.y - o.y * b.x) / (len * lb);
+        out[k].offset *= std::min(2.0 / std::max(ca + cb, 1e-12), kMiterLimit);
+    }
 }
 
 ScreenRibbon ribbonBetween(const ProjectedVertex& a, const ProjectedVertex& b) {

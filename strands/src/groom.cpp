@@ -31,6 +31,16 @@ double Groom::totalLength() const {
     return total;
 }
 
+void strandTangents(std::span<const Vec3f> points, std::span<Vec3f> tangents) {
+    Vec3f previous(0.0f);
+    for (std::size_t k = 0; k < points.size(); ++k) {
+        const Vec3f next =
+            k + 1 < points.size() ? normalizeOr(points[k + 1] - points[k], Vec3f(0.0f)) : Vec3f(0.0f);
+        tangents[k] = normalizeOr(previous + next, normalizeOr(next, previous));
+        previous = next;
+    }
+}
+
 GroomStats computeStats(const Groom& groom) {
     GroomStats st;
     st.strands = groom.strandCount();

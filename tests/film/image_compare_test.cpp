@@ -8,18 +8,18 @@
 namespace hairvox {
 namespace {
 
-BeautyImage constantImage(int width, int height, Rgb value, float mask) {
-    BeautyImage image;
+ComparedImage constantImage(int width, int height, Rgb value, float mask) {
+    ComparedImage image;
     image.width = width;
     image.height = height;
-    image.beauty.assign(std::size_t(width * height), value);
+    image.value.assign(std::size_t(width * height), value);
     image.mask.assign(std::size_t(width * height), mask);
     return image;
 }
 
 TEST(ImageCompare, ZeroForIdenticalImages) {
-    BeautyImage a = constantImage(7, 5, Rgb(0.2f, 0.5f, 0.9f), 1.0f);
-    a.beauty[3] = Rgb(3.0f, 0.0f, 1.0f);
+    ComparedImage a = constantImage(7, 5, Rgb(0.2f, 0.5f, 0.9f), 1.0f);
+    a.value[3] = Rgb(3.0f, 0.0f, 1.0f);
     a.mask[4] = 0.0f;
     const std::optional<ImageError> e = compareImages(a, a);
     ASSERT_TRUE(e);
@@ -29,8 +29,8 @@ TEST(ImageCompare, ZeroForIdenticalImages) {
 }
 
 TEST(ImageCompare, RelativeErrorsOfAUniformScale) {
-    const BeautyImage reference = constantImage(6, 4, Rgb(0.5f), 0.3f);
-    const BeautyImage brighter = constantImage(6, 4, Rgb(0.55f), 0.3f);
+    const ComparedImage reference = constantImage(6, 4, Rgb(0.5f), 0.3f);
+    const ComparedImage brighter = constantImage(6, 4, Rgb(0.55f), 0.3f);
     const std::optional<ImageError> e = compareImages(brighter, reference);
     ASSERT_TRUE(e);
     EXPECT_NEAR(e->relL1, 0.1, 1e-6);
@@ -38,18 +38,18 @@ TEST(ImageCompare, RelativeErrorsOfAUniformScale) {
 }
 
 TEST(ImageCompare, OnlyHairPixelsCount) {
-    BeautyImage reference = constantImage(4, 4, Rgb(1.0f), 1.0f);
-    BeautyImage estimate = reference;
+    ComparedImage reference = constantImage(4, 4, Rgb(1.0f), 1.0f);
+    ComparedImage estimate = reference;
     for (std::size_t p = 0; p < 8; ++p) {
         reference.mask[p] = 0.0f;
-        estimate.beauty[p] = Rgb(100.0f); // background or head: not compared
+        estimate.value[p] = Rgb(100.0f); // background or head: not compared
     }
     const std::optional<ImageError> e = compareImages(estimate, reference);
     ASSERT_TRUE(e);
     EXPECT_EQ(e->relL1, 0.0);
     EXPECT_EQ(e->pixels, 8u);
 
-    const BeautyImage noHair = constantImage(4, 4, Rgb(1.0f), 0.0f);
+    const ComparedImage noHair = constantImage(4, 4, Rgb(1.0f), 0.0f);
     EXPECT_FALSE(compareImages(estimate, noHair));
     EXPECT_THROW(compareImages(constantImage(4, 3, Rgb(1.0f), 1.0f), reference), InputError);
 }

@@ -63,7 +63,7 @@ TEST(RenderPipeline, EveryModeWritesItsLayers) {
         const Scene scene = smallScene(dir, mode);
         const SceneRender r = renderScene(scene, options(dir));
         ASSERT_EQ(r.written.size(), 2u) << toString(mode);
-        EXPECT_EQ(r.image.stats.invalidSamples, 0u) << toString(mode);
+        EXPECT_EQ(r.raster->invalidSamples, 0u) << toString(mode);
         const ExrImage exr = readExr(scene.output.exr);
         for (const char* layer : {"R", "G", "B", "A", "direct_R.R", "direct_TT.G", "direct_TRT.B",
                                   "back_direct.R", "scatter.G", "head.R", "background.B", "hair.A",
@@ -121,19 +121,19 @@ TEST(RenderPipeline, OneFiberIsTheShaderTimesCoverageAndIrradiance) {
         const Vec3f p = o + t * dir3;
         if (std::abs(p.y) > 1e-4f)
             continue; // the centre ray passes beside the fiber
-        const std::size_t i = r.image.film.index(x, 16);
-        const double coverage = hairAlpha(r.image.film, i);
+        const std::size_t i = r.film.index(x, 16);
+        const double coverage = hairAlpha(r.film, i);
         ASSERT_GT(coverage, 0.05) << x;
         const Rgb f = shader
                           .shade(scene.lights[0].direction, glm::normalize(o - p), Vec3f(1, 0, 0),
                                  GlobalTerm::unoccluded())
                           .total();
         const Rgb expected = float(coverage) * 2.5f * f;
-        const Rgb beauty = r.image.film.beauty(i);
+        const Rgb beauty = r.film.beauty(i);
         for (int c = 0; c < 3; ++c)
             EXPECT_NEAR(beauty[c], expected[c], 2e-3f * expected[c] + 1e-7f)
                 << "x " << x << " c " << c;
-        EXPECT_NEAR(r.image.film.layer("key.V").scalar(i), 1.0f, 1e-6f);
+        EXPECT_NEAR(r.film.layer("key.V").scalar(i), 1.0f, 1e-6f);
         ++checked;
     }
     EXPECT_GE(checked, 10);
@@ -148,9 +148,9 @@ TEST(RenderPipeline, NoLightGivesBlackHair) {
     for (const LightReport& l : r.lights)
         EXPECT_TRUE(l.skipped) << l.name;
     double alpha = 0;
-    for (std::size_t i = 0; i < r.image.film.pixelCount(); ++i) {
-        EXPECT_EQ(hairRadiance(r.image.film, i), 0.0);
-        alpha += hairAlpha(r.image.film, i);
+    for (std::size_t i = 0; i < r.film.pixelCount(); ++i) {
+        EXPECT_EQ(hairRadiance(r.film, i), 0.0);
+        alpha += hairAlpha(r.film, i);
     }
     EXPECT_GT(alpha, 10.0); // the hair is there, and black
 }
@@ -189,9 +189,9 @@ TEST(RenderPipeline, HeadShadowsTheHairBehindIt) {
     scene.lights[0].direction = Vec3f(0, 0, -1);
     const SceneRender shadowed = renderScene(scene, options(dir), false);
     double alpha = 0;
-    for (std::size_t i = 0; i < shadowed.image.film.pixelCount(); ++i) {
-        EXPECT_EQ(hairRadiance(shadowed.image.film, i), 0.0) << "pixel " << i;
-        alpha += hairAlpha(shadowed.image.film, i);
+    for (std::size_t i = 0; i < shadowed.film.pixelCount(); ++i) {
+        EXPECT_EQ(hairRadiance(shadowed.film, i), 0.0) << "pixel " << i;
+        alpha += hairAlpha(shadowed.film, i);
     }
     EXPECT_GT(alpha, 5.0);
     EXPECT_EQ(shadowed.lights[0].stats.blockedByOccluder, shadowed.lights[0].stats.queries);
@@ -199,8 +199,8 @@ TEST(RenderPipeline, HeadShadowsTheHairBehindIt) {
     scene.lights[0].direction = Vec3f(0, 0, 1);
     const SceneRender lit = renderScene(scene, options(dir), false);
     double radiance = 0;
-    for (std::size_t i = 0; i < lit.image.film.pixelCount(); ++i)
-        radiance += hairRadiance(lit.image.film, i);
+    for (std::size_t i = 0; i < lit.film.pixelCount(); ++i)
+        radiance += hairRadiance(lit.film, i);
     EXPECT_GT(radiance, 0.1);
 }
 
@@ -217,13 +217,13 @@ TEST(RenderPipeline, HeadIsLambertianAndHidesTheHairBehindIt) {
     scene.lights[0].color = Rgb(1.0f);
     const SceneRender r = renderScene(scene, options(dir), false);
     // Lit head-on at the centre: albedo/π · E, wholly covering the pixel, at depth 0.4.
-    const Film& film = r.image.film;
+    const Film& film = r.film;
     const std::size_t c = film.index(128, 128);
     EXPECT_NEAR(film.layer(kSurfaceLayer).rgb(c).r, scene.head->albedo.r * 2.0f / float(Pi), 1e-3f);
     EXPECT_NEAR(film.layer(Film::kAlpha).scalar(c), 1.0f, 1e-6f);
     EXPECT_NEAR(film.layer(kDepthLayer).scalar(c), 0.4f, 0.01f);
     // The hair behind the head (its back half, from this camera) is culled by tiles.
-    EXPECT_GT(r.image.stats.segmentTilesBehindSurfaces, 0u);
+    EXPECT_GT(r.raster->segmentTilesBehindSurfaces, 0u);
 }
 
 /// Every layer of the film, concatenated as bytes.
@@ -240,10 +240,10 @@ TEST(RenderPipeline, SameBytesForAnyThreadCount) {
     test::TempDir dir;
     const Scene scene = smallScene(dir);
     const std::vector<unsigned char> one =
-        filmBytes(renderScene(scene, options(dir, 1), false).image.film);
+        filmBytes(renderScene(scene, options(dir, 1), false).film);
     EXPECT_GT(one.size(), 96u * 96u * 4u);
     for (const int threads : {2, 8})
-        EXPECT_TRUE(filmBytes(renderScene(scene, options(dir, threads), false).image.film) == one)
+        EXPECT_TRUE(filmBytes(renderScene(scene, options(dir, threads), false).film) == one)
             << threads << " threads";
 }
 

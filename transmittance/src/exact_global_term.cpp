@@ -100,11 +100,10 @@ GlobalTerm ExactLightGlobalTerm::evaluateOne(const GlobalTermQuery& q,
         int m = 0;
         Rgb logP(0.0f), beta2(0.0f);
         for (const FiberCrossing& c : hits) {
-            if (own && c.strand == own->strand) {
-                const float chord = glm::distance(origin + c.t * path.omega, q.position);
-                if (std::abs(c.arcLength - own->arcLength) <= 1.5f * chord + ownSlack)
-                    continue; // the point's own fiber, not a curl coming back
-            }
+            if (own && RayScene::isOwnFiber(c.strand, c.arcLength, *own,
+                                            glm::distance(origin + c.t * path.omega, q.position),
+                                            ownSlack))
+                continue; // the point's own fiber, not a curl coming back
             const CrossingTable::Values v =
                 model_.crossings.crossing(glm::dot(path.omega, c.tangent));
             logP += v.logABar_f;

@@ -103,28 +103,39 @@ std::optional<double> optionalFromJson(const json& j) {
 
 } // namespace
 
-void writeBeautyImage(const std::filesystem::path& path, const BeautyImage& image) {
+void writeComparedImage(const std::filesystem::path& path, const ComparedImage& image) {
     FloatFile file;
-    file.header = {std::uint64_t(image.width), std::uint64_t(image.height)};
-    file.data.reserve(image.beauty.size() * 4);
-    for (const Rgb& c : image.beauty)
+    file.header = {std::uint64_t(image.width), std::uint64_t(image.height),
+                   image.halfA.empty() ? 0u : 1u};
+    file.data.reserve(image.value.size() * 7);
+    for (const Rgb& c : image.value)
         file.data.insert(file.data.end(), {c.r, c.g, c.b});
     file.data.insert(file.data.end(), image.mask.begin(), image.mask.end());
+    for (const Rgb& c : image.halfA)
+        file.data.insert(file.data.end(), {c.r, c.g, c.b});
     writeFloatFile(path, file);
 }
 
-BeautyImage readBeautyImage(const std::filesystem::path& path) {
+ComparedImage readComparedImage(const std::filesystem::path& path) {
     const FloatFile file = readFloatFile(path);
-    if (file.header.size() != 2 || file.header[0] * file.header[1] * 4 != file.data.size())
+    if (file.header.size() != 3 || file.header[2] > 1 ||
+        file.header[0] * file.header[1] * (file.header[2] == 1 ? 7 : 4) != file.data.size())
         throw InputError(strCat(path.string(), ": not a reference image"));
-    BeautyImage image;
+    ComparedImage image;
     image.width = static_cast<int>(file.header[0]);
     image.height = static_cast<int>(file.header[1]);
-    const std::size_t n = file.data.size() / 4;
-    image.beauty.resize(n);
-    for (std::size_t p = 0; p < n; ++p)
-        image.beauty[p] = Rgb(file.data[3 * p], file.data[3 * p + 1], file.data[3 * p + 2]);
-    image.mask.assign(file.data.begin() + std::ptrdiff_t(3 * n), file.data.end());
+    const std::size_t n = file.header[0] * file.header[1];
+    const float* f = file.data.data();
+    image.value.resize(n);
+    for (std::size_t p = 0; p < n; ++p, f += 3)
+        image.value[p] = Rgb(f[0], f[1], f[2]);
+    image.mask.assign(f, f + n);
+    f += n;
+    if (file.header[2] == 1) {
+        image.halfA.resize(n);
+        for (std::size_t p = 0; p < n; ++p, f += 3)
+            image.halfA[p] = Rgb(f[0], f[1], f[2]);
+    }
     return image;
 }
 
@@ -229,7 +240,11 @@ json measurementToJson(const BenchMeasurement& m) {
     if (m.image)
         j["image"] = {{"rel_l1", m.image->relL1},
                       {"rel_rmse", m.image->relRmse},
-                      {"pixels", m.image->pixels}};
+                      {"pixels", m.image->pixels},
+                      {"rel_bias", m.image->relBias},
+                      {"noise_floor_l1", m.image->noiseFloorL1},
+                      {"rel_l1_noise_removed", m.image->relL1NoiseRemoved},
+                      {"rel_rmse_noise_removed", m.image->relRmseNoiseRemoved}};
     if (m.probe)
         j["probe"] = {{"mae_v", m.probe->maeV},
                       {"mae_ts", m.probe->maeT_s},
@@ -257,8 +272,17 @@ BenchMeasurement measurementFromJson(const json& j) {
     m.voxelSize = j.at("voxel_size").get<double>();
     m.defaultVoxelSize = j.at("default_voxel_size").get<double>();
     if (const json& i = j.at("image"); !i.is_null())
-        m.image = ImageError{i.at("rel_l1").get<double>(), i.at("rel_rmse").get<double>(),
-                             i.at("pixels").get<std::size_t>()};
+    {
+        ImageError e;
+        e.relL1 = i.at("rel_l1").get<double>();
+        e.relRmse = i.at("rel_rmse").get<double>();
+        e.relBias = i.at("rel_bias").get<double>();
+        e.pixels = i.at("pixels").get<std::size_t>();
+        e.noiseFloorL1 = i.at("noise_floor_l1").get<double>();
+        e.relL1NoiseRemoved = i.at("rel_l1_noise_removed").get<double>();
+        e.relRmseNoiseRemoved = i.at("rel_rmse_noise_removed").get<double>();
+        m.image = e;
+    }
     if (const json& p = j.at("probe"); !p.is_null())
         m.probe = ProbeError{p.at("mae_v").get<double>(), p.at("mae_ts").get<double>(),
                              p.at("bias_n").get<double>(), p.at("mean_n_ref").get<double>()};

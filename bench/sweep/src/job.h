@@ -50,8 +50,8 @@ void writeJsonFile(const std::filesystem::path& path, const nlohmann::json& j);
 nlohmann::json readJsonFile(const std::filesystem::path& path);
 
 /// A reference image in the sweep's working directory (float, not half: it is compared against).
-void writeBeautyImage(const std::filesystem::path& path, const BeautyImage& image);
-BeautyImage readBeautyImage(const std::filesystem::path& path);
+void writeComparedImage(const std::filesystem::path& path, const ComparedImage& image);
+ComparedImage readComparedImage(const std::filesystem::path& path);
 
 /// Global terms per light (outer) and probe point (inner).
 void writeProbeTerms(const std::filesystem::path& path,

@@ -87,8 +87,8 @@ BenchMeasurement timeRenders(const Scene& scene, const BenchJob& job,
         shade.push_back(t.shade);
         write.push_back(t.write);
         total.push_back(t.total());
-        m.segments = render.image.stats.segments;
-        m.shadingPoints = render.image.stats.shadingPoints;
+        m.segments = render.raster ? render.raster->segments : 0;
+        m.shadingPoints = render.raster ? render.raster->shadingPoints : 0;
         m.activeVoxels = render.activeVoxels;
         m.voxelSize = scene.globalTermMode == GlobalTermMode::Exact ? double(scene.exact.radius)
                                                                     : render.voxelSize;
@@ -96,7 +96,7 @@ BenchMeasurement timeRenders(const Scene& scene, const BenchJob& job,
             runs = 1;
         // Only the last film is kept: holding one across renders would raise the peak.
         if (r + 1 == runs && lastFilm)
-            *lastFilm = std::move(render.image.film);
+            *lastFilm = std::move(render.film);
     }
     m.times = {median(load),   median(voxelize), median(tables), median(globalTerm),
                median(raster), median(shade),    median(write)};
@@ -129,7 +129,7 @@ BenchMeasurement runJob(const BenchJob& job) {
         Film film;
         BenchMeasurement m = timeRenders(scene, job, options, &film);
         m.defaultVoxelSize = h0;
-        writeBeautyImage(job.referenceImage, BeautyImage::fromFilm(film, kHairAlphaLayer));
+        writeComparedImage(job.referenceImage, ComparedImage::beautyOf(film, kHairAlphaLayer));
         for (std::size_t i = 0; i < job.probeScales.size() && job.probePoints > 0; ++i) {
             Scene probe = scene;
             probe.exact.rays = job.probeRays;
@@ -150,8 +150,8 @@ BenchMeasurement runJob(const BenchJob& job) {
     BenchMeasurement m = timeRenders(scene, job, options, &film);
     m.defaultVoxelSize = m.voxelSize / job.config.voxelScale;
     if (!job.referenceImage.empty())
-        m.image = compareImages(BeautyImage::fromFilm(film, kHairAlphaLayer),
-                                readBeautyImage(job.referenceImage));
+        m.image = compareImages(ComparedImage::beautyOf(film, kHairAlphaLayer),
+                                readComparedImage(job.referenceImage));
     film = Film();
     if (job.probePoints > 0 && !job.probeFiles.empty()) {
         const std::vector<GlobalTermQuery> points = probePointsOf(scene, job, nullptr);

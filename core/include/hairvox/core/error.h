@@ -17,10 +17,12 @@ public:
     using std::runtime_error::runtime_error;
 };
 
-/// A long operation was interrupted by the user (Ctrl-C); the CLI exits with 130.
+/// A long operation was interrupted by the user (Ctrl-C); the CLI prints the
+/// message and exits with 130.
 class Interrupted : public std::runtime_error {
 public:
-    Interrupted() : std::runtime_error("interrupted") {}
+    Interrupted() : std::runtime_error("interrupted; no partial output was written") {}
+    explicit Interrupted(const std::string& message) : std::runtime_error(message) {}
 };
 
 /// Concatenates anything printable into a string: strCat("file ", name, ": ", count).

@@ -27,4 +27,10 @@ private:
 /// The number of threads TBB will use now.
 int activeThreadCount();
 
+/// Sets flush-to-zero and denormals-are-zero for the calling thread (the x86
+/// MXCSR bits): denormal floats then cost what normal ones do. Embree asks for
+/// it ("a severe performance impact" otherwise); the path tracer sets it in
+/// every task, so its results do not depend on which thread ran what.
+void flushDenormalsToZero();
+
 } // namespace hairvox

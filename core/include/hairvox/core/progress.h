@@ -1,12 +1,14 @@
 // hairvox core: progress reporting for long operations.
 //
 // Modelled on pbrt-v4's ProgressReporter: workers add completed work
-// atomically; one background thread redraws the bar on stderr with back-off.
+// atomically; one background thread redraws the bar on stderr with back-off,
+// with the time so far and an estimate of the time left (ETA).
 // Disabled (and costing one atomic add per call) when stderr is not a terminal
 // or the user asked for quiet output.
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <mutex>
@@ -28,6 +30,8 @@ public:
     void update(std::uint64_t work = 1) { done_.fetch_add(work, std::memory_order_relaxed); }
     /// Draws the final state and stops the redraw thread; idempotent.
     void finish();
+    /// The work stops after this many seconds at the latest: the ETA never exceeds it.
+    void limitTime(double seconds);
 
 private:
     void draw(bool final) const;
@@ -36,6 +40,8 @@ private:
     std::uint64_t total_;
     std::atomic<std::uint64_t> done_{0};
     bool enabled_;
+    std::chrono::steady_clock::time_point start_;
+    std::atomic<double> timeLimit_{0.0}; // read by the redraw thread
     bool finished_ = false;
     std::mutex mutex_;
     std::condition_variable wake_;

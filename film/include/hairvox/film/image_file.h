@@ -58,6 +58,11 @@ struct ExrImage {
 /// Throws InputError naming the file if it cannot be read.
 ExrImage readExr(const std::filesystem::path& path);
 
+/// The film an EXR image holds: channels R, G, B as the beauty layer "",
+/// X.R, X.G, X.B as the RGB layer X, any other channel as a scalar layer of its
+/// name; every layer full precision. (writeExr's inverse, up to half rounding.)
+Film filmFromExr(const ExrImage& image);
+
 /// The tone-mapped 8-bit sRGB preview of the film's beauty, row-major RGB.
 std::vector<std::uint8_t> previewPixels(const Film& film, float exposure, ToneMap toneMap);
 

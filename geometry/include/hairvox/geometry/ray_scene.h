@@ -1,6 +1,6 @@
 // hairvox geometry: the scene as rays meet it (Embree 3) — the strands as
-// ray-facing ribbons, the one geometry that exact mode's shadow rays and the
-// path tracer both intersect.
+// ray-facing ribbons and the opaque surfaces, the one geometry that exact
+// mode's shadow rays and the path tracer both intersect.
 //
 // Each strand segment is an Embree flat linear curve of width k·D (the fiber
 // scale's ribbonWidth(): a modeled strand stands for k hairs of diameter D
@@ -8,6 +8,11 @@
 // fiber of tangent u hits it with probability proportional to k·D·|ω × u| —
 // the cross-section the grid modes integrate (docs/DESIGN.md §5) — and each
 // hit is one hair.
+//
+// A hit's tangent is the shading tangent the rasterizer uses too: the strand's
+// point tangents interpolated along the segment (strands/groom.h). Embree's
+// primitives are pieces of the segments (a few per segment: tighter boxes,
+// faster rays), which the queries report as their segments.
 //
 // crossings(): every fiber along a ray. A context filter records and rejects
 // every candidate, so traversal visits all of them; the hits are then sorted
@@ -18,17 +23,36 @@
 // locate(): the strand a point lies on (a shading point's own fiber, which
 // its shadow rays must not count): the query's strand hint, else a uniform
 // grid of segments built on first use (Embree 3 has no point queries on curves).
+//
+// The own fiber: a ray leaving a point on a fiber must not meet that fiber
+// again at its start. A crossing of the point's own strand is the fiber
+// itself when the strand runs nearly straight between the point and the
+// crossing — arc-length distance ≤ 1.5 × chord + slack — and is skipped; a
+// curl looping back across the ray (arc length much longer than the chord) is
+// another crossing and counts (isOwnFiber(); exact mode, and the path
+// tracer's rays through intersect() and occluded()).
+//
+// Ribbons are butt-ended: Embree's flat linear curves have round end caps,
+// whose hits are rejected, so that a ray meets exactly the cross-section
+// k·D·|ω × u| per unit length — what the rasterizer covers and what the grid
+// integrates (a fiber seen end-on blocks nothing).
+//
+// Surfaces: opaque spheres (the head), intersected analytically
+// (Sphere::intersect); they block light and end paths.
 #pragma once
 
 #include <hairvox/core/vecmath.h>
 #include <hairvox/strands/fiber_scale.h>
 #include <hairvox/strands/groom.h>
 
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <memory>
 #include <optional>
 #include <vector>
+
+struct RTCFilterFunctionNArguments;
 
 namespace hairvox {
 
@@ -40,7 +64,7 @@ struct FiberCrossing {
     std::uint32_t strand;
     std::uint32_t segment; ///< global segment index (Embree primitive)
     float arcLength;       ///< position of the crossing along its strand, from the root
-    Vec3f tangent;         ///< unit tangent of the crossed segment, root → tip
+    Vec3f tangent;         ///< unit shading tangent there (strands/groom.h shadingTangent)
 };
 
 /// A point on a strand's centreline.
@@ -50,11 +74,29 @@ struct FiberPoint {
     float arcLength; ///< from the root
 };
 
+/// The point a ray leaves from when it lies on a fiber, with the slack of the
+/// own-fiber rule (see the file comment).
+struct RayOrigin {
+    FiberPoint fiber;
+    float slack = 0;
+};
+
+/// What a ray meets first.
+struct RayHit {
+    enum class Kind { Fiber, Surface };
+    Kind kind = Kind::Fiber;
+    float t = 0;
+    FiberPoint fiber{};       ///< Fiber: where, on which strand
+    Vec3f tangent{0.0f};      ///< Fiber: unit shading tangent there, root → tip (shadingTangent)
+    Vec3f normal{0.0f};       ///< Surface: unit outward normal
+    std::uint32_t surface = 0; ///< Surface: its index among the scene's surfaces
+};
+
 class RayScene {
 public:
-    /// The groom's strands as ribbons of width scale.ribbonWidth(); locate()
-    /// searches within max(D, k·D) of a centreline.
-    RayScene(const Groom& groom, const FiberScale& scale);
+    /// The groom's strands as ribbons of width scale.ribbonWidth() (locate()
+    /// searches within max(D, k·D) of a centreline) and opaque spheres.
+    RayScene(const Groom& groom, const FiberScale& scale, std::vector<Sphere> spheres = {});
     ~RayScene();
     RayScene(const RayScene&) = delete;
     RayScene& operator=(const RayScene&) = delete;
@@ -69,13 +111,36 @@ public:
     std::optional<FiberPoint> locate(const Vec3f& p,
                                      std::uint32_t strandHint = kUnknownStrand) const;
 
+    /// The first fiber or surface on origin + t·dir, t ∈ (0, tMax), skipping
+    /// the origin's own fiber when it lies on one. Thread-safe.
+    std::optional<RayHit> intersect(const Vec3f& origin, const Vec3f& dir, float tMax,
+                                    const RayOrigin* from = nullptr) const;
+    /// Whether any fiber or surface lies on the segment (a binary shadow ray).
+    bool occluded(const Vec3f& origin, const Vec3f& dir, float tMax,
+                  const RayOrigin* from = nullptr) const;
+    /// Whether an opaque surface lies on the segment (fibers ignored).
+    bool surfaceOccluded(const Vec3f& origin, const Vec3f& dir, float tMax) const;
+
+    /// The own-fiber rule: a crossing at arc length `arcLength` of the strand
+    /// `own` lies on, seen `chord` away from `own`, is that fiber itself.
+    static bool isOwnFiber(std::uint32_t strand, float arcLength, const FiberPoint& own, float chord,
+                           float slack) {
+        return strand == own.strand && std::abs(arcLength - own.arcLength) <= 1.5f * chord + slack;
+    }
+
     float ribbonWidth() const { return width_; }
+    const std::vector<Sphere>& spheres() const { return spheres_; }
 
 private:
     struct Impl;
+    /// Embree's filter for every query: rejects end-cap hits and the origin's
+    /// own fiber, or collects every hit for crossings().
+    static void filterHits(const RTCFilterFunctionNArguments* args);
+
     std::unique_ptr<Impl> impl_;
     float width_;
     float locateDistance_;
+    std::vector<Sphere> spheres_;
 };
 
 } // namespace hairvox

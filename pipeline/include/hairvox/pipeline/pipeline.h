@@ -1,13 +1,18 @@
-// hairvox pipeline: the whole render of one scene (docs/DESIGN.md §1):
-//   load the groom → splat the fiber grid (grid and approx modes) → dual-
-//   scattering tables (disk cache) → global term per light → surfaces →
-//   raster + shade → EXR and PNG,
+// hairvox pipeline: the whole render of one scene (docs/DESIGN.md §1), by the
+// scene's integrator:
+//  - dual scattering (the default): load the groom → splat the fiber grid
+//    (grid and approx modes) → dual-scattering tables (disk cache) → global
+//    term per light → surfaces → raster + shade → EXR and PNG;
+//  - path: load the groom → path trace the same fibers (pathtrace/) → EXR and
+//    PNG; optionally continuing from the scene's own earlier EXR;
 // timed stage by stage, with the counts of what each stage skipped (§7).
 // The CLI's render, probe and transmittance commands and the benchmarks all go
 // through loadSceneAssets(), so every consumer switches global-term modes the
 // same way.
 #pragma once
 
+#include <hairvox/film/image_compare.h>
+#include <hairvox/pathtrace/path_tracer.h>
 #include <hairvox/pipeline/scene.h>
 #include <hairvox/render/rasterizer.h>
 #include <hairvox/shading/dual_scattering_tables.h>
@@ -31,12 +36,19 @@ struct PipelineOptions {
     bool progress = false; ///< progress bars on stderr (the caller checks for a terminal)
     std::filesystem::path tableCacheDir; ///< empty: defaultTableCacheDir()
     GridOptions grid; ///< settings of the grid and approx modes (measured defaults)
+    /// Path tracing: add samples to the scene's own EXR output when it exists
+    /// (InputError if it was rendered from another scene or seed).
+    bool continuePathTrace = false;
 };
 
 /// Wall-clock seconds per stage.
 struct StageTimes {
-    double load = 0, voxelize = 0, tables = 0, globalTerm = 0, raster = 0, shade = 0, write = 0;
-    double total() const { return load + voxelize + tables + globalTerm + raster + shade + write; }
+    double load = 0, voxelize = 0, tables = 0, globalTerm = 0, raster = 0, shade = 0;
+    double trace = 0; ///< path tracing
+    double write = 0;
+    double total() const {
+        return load + voxelize + tables + globalTerm + raster + shade + trace + write;
+    }
 };
 
 /// Everything a scene's global term is computed from.
@@ -71,7 +83,10 @@ struct LightReport {
 };
 
 struct SceneRender {
-    RasterOutput image;
+    Film film;
+    std::optional<RasterStats> raster;       ///< the dual-scattering integrator's
+    std::optional<PathTraceStats> pathTrace; ///< the path tracer's
+    std::vector<std::string> warnings;       ///< for the user (rejected shader results, ...)
     StageTimes times;
     std::vector<LightReport> lights;
     std::vector<std::filesystem::path> written;
@@ -83,12 +98,27 @@ struct SceneRender {
 SceneRender renderScene(const Scene& scene, const PipelineOptions& options, bool writeFiles = true);
 
 /// Writes the outputs the scene asks for (scene.output.exr and .png, each if
-/// non-empty) and returns their paths. EXR attributes record the scene's name,
-/// mode, voxel size and shading rate plus `attributes`; the camera's
-/// world-to-camera matrix goes with it.
+/// non-empty) and returns their paths. EXR attributes record the scene's name
+/// and integrator — the global-term mode, voxel size and shading rate of dual
+/// scattering, or a path trace's spp, seed and render hash — plus
+/// `attributes`; the camera's world-to-camera matrix goes with it.
 std::vector<std::filesystem::path>
 writeOutputs(const Film& film, const Scene& scene,
              const std::map<std::string, std::string>& attributes = {});
+
+/// The layers that sum to the hair's radiance in a film of either integrator:
+/// direct_R, direct_TT, direct_TRT and back_direct + scatter (dual
+/// scattering) or multiple (path tracing). std::out_of_range if the film has
+/// neither set.
+std::vector<std::string> hairRadianceLayers(const Film& film);
+/// The hair's radiance over the hair pixels, with the path tracer's variance
+/// of it where the film has one: what the dual-scattering model is judged on.
+ComparedImage hairRadianceOf(const Film& film);
+
+/// What a path trace's samples depend on (groom content, fiber scale and
+/// optics, lights, camera, head, background, seed, depth settings): the key
+/// under which a run may continue another.
+std::string pathTraceHash(const Scene& scene, const Groom& groom);
 
 /// The closing report: time per stage and what was skipped.
 void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& render);

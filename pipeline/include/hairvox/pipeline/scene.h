@@ -18,6 +18,7 @@
 #include <hairvox/film/image_file.h>
 #include <hairvox/geometry/camera.h>
 #include <hairvox/geometry/light.h>
+#include <hairvox/pathtrace/path_tracer.h>
 #include <hairvox/render/fragment_shader.h>
 #include <hairvox/shading/fiber_params.h>
 #include <hairvox/strands/fiber_scale.h>
@@ -59,6 +60,16 @@ struct ExactSettings {
     float radius = 0;       ///< r, scene units, [0, 1000]
 };
 
+/// How a scene is rendered: the dual-scattering rasterizer, or the path tracer
+/// of the same fibers (the ground truth; pathtrace/path_tracer.h).
+enum class Integrator { DualScattering, Path };
+
+inline constexpr EnumNames<Integrator, 2> kIntegratorNames{{{
+    {Integrator::DualScattering, "dual_scattering"},
+    {Integrator::Path, "path"},
+}}};
+inline const char* toString(Integrator i) { return kIntegratorNames.name(i); }
+
 struct OutputSettings {
     std::filesystem::path exr;         ///< relative to the working directory; empty: not written
     std::filesystem::path png;         ///< relative to the working directory; empty: not written
@@ -76,6 +87,8 @@ struct Scene {
     CameraParams camera;
     std::optional<Head> head;
     std::optional<float> voxelSize; ///< fiber grid voxel size; nullopt: derived from the groom
+    Integrator integrator = Integrator::DualScattering;
+    PathTraceSettings pathTrace; ///< the path integrator's spp, time limit, depth and seed
     GlobalTermMode globalTermMode = GlobalTermMode::Grid;
     ExactSettings exact;
     ShadingRate shadingRate = ShadingRate::Fragment;

@@ -19,6 +19,20 @@
 // budget of 0.2 µs per shade needs. The table's L1 error over φ is < 0.1% of
 // N (tests/shading/marschner_test.cpp); evalExact() is the reference.
 //
+// Importance sampling of f_s·cos θ_i (sample(), pdf(); the path tracer's
+// scattering at a fiber): a lobe p is chosen with probability proportional to
+// its albedo A_p(θ_o) = ∫ f_p cos θ_i dω_i (tabulated over θ_o); θ_i from M_p,
+// i.e. θ_h ~ N(α_p, β_p²) truncated so that θ_i ∈ [−π/2, π/2] (inverse CDF);
+// φ from N_p's own table: the row of cos θ_d on either side is chosen with its
+// bilinear weight and |φ| drawn from that row's piecewise-linear density
+// (exact inverse CDF), the sign at random; a 2% uniform share in φ keeps the
+// density positive wherever f_s is (eccentric TRT, whose proposal averages
+// the cross-section orientations). The density of the whole mixture,
+//   pdf(ω_i) = Σ_p w_p(θ_o) pdf_θ,p(θ_i | θ_o) pdf_φ,p(φ | θ_d) / cos θ_i,
+// is exact, so weight = f_s·cos θ_i / pdf is unbiased for any table error,
+// and its variance is small where the proposal follows f_s (d'Eon et al.
+// 2013 sample Marschner-like lobes the same way: lobe, then θ, then φ).
+//
 // Eccentricity needs the azimuthal half angle φ_h = (φ_i + φ_o)/2, i.e. the
 // orientation of the fiber's elliptical cross-section, which a curve does not
 // carry: FiberAngles measures azimuths from the first axis of
@@ -75,6 +89,17 @@ struct FiberAngles {
 
 std::ostream& operator<<(std::ostream& os, const FiberAngles& a);
 
+/// A direction sampled from f_s·cos θ_i for a given ω_o (MarschnerBcsdf::sample).
+struct BcsdfSample {
+    Vec3f wi{0.0f};       ///< unit; zero for an invalid sample (weight 0)
+    LobeValues f;         ///< f_s per lobe at (ω_i, ω_o)
+    float pdf = 0;        ///< solid-angle density of ω_i (the whole mixture)
+    Rgb weight{0.0f};     ///< f_s·cos θ_i / pdf, summed over the lobes
+    Lobe lobe = Lobe::R;  ///< the lobe ω_i was drawn from
+
+    bool valid() const { return pdf > 0; }
+};
+
 class MarschnerBcsdf {
 public:
     /// Validates `params` (InputError with the valid range) and tabulates N_p.
@@ -87,6 +112,19 @@ public:
     LobeValues eval(const FiberAngles& a) const;
     /// f_s per lobe from the exact N_p (root solves): the reference for tests.
     LobeValues evalExact(const FiberAngles& a) const;
+
+    /// A direction ω_i for the outgoing ω_o about the tangent u (all unit),
+    /// from four uniforms in [0, 1) (see the file comment). Deterministic in
+    /// its inputs.
+    BcsdfSample sample(const Vec3f& wo, const Vec3f& u, const std::array<float, 4>& uniforms) const;
+    /// The solid-angle density sample() draws ω_i with, for ω_o.
+    float pdf(const Vec3f& wi, const Vec3f& wo, const Vec3f& u) const;
+    float pdf(const FiberAngles& a) const;
+    /// The density of sample() given that it chose lobe p (what the mixture weighs).
+    float pdf(const FiberAngles& a, Lobe p) const;
+    /// A_p(θ) = ∫ f_p(θ, ω) cos θ_ω dω, the mean over RGB (the lobe selection
+    /// weights; tabulated over θ with linear interpolation).
+    float lobeAlbedo(Lobe p, float theta) const;
 
     /// M_p(θ_h) = ½·g(θ_h − α_p; β_p).
     float M(Lobe p, float theta_h) const;
@@ -113,13 +151,18 @@ public:
 private:
     struct AzimuthalTable;
 
+    struct SamplingTables;
+
     /// n_p·M_p(θ_h)/cos²θ_d per lobe.
     LobeValues withLongitudinal(LobeValues n, const FiberAngles& a) const;
+    /// Lobe selection probabilities at θ_o.
+    std::array<float, 3> lobeWeights(float theta_o) const;
 
     FiberParams params_;
     std::array<float, 3> alpha_{}, beta_{};
     std::array<LongitudinalLobe, 3> M_;           ///< M_p (longitudinal.h)
     std::shared_ptr<const AzimuthalTable> table_; ///< shared: copies are cheap
+    std::shared_ptr<const SamplingTables> sampling_;
 };
 
 std::ostream& operator<<(std::ostream& os, const MarschnerBcsdf& b);

@@ -47,6 +47,20 @@ struct Groom {
     double totalLength() const;
 };
 
+/// The unit tangents at one strand's points (root → tip): at an inner point
+/// the bisector of its two segments' directions, at the root and the tip
+/// their one segment's. Between points, the shading tangent is these
+/// interpolated along the segment — the rasterizer's and the path tracer's
+/// fibers are shaded alike.
+void strandTangents(std::span<const Vec3f> points, std::span<Vec3f> tangents);
+
+/// The unit tangent at a point `t` ∈ [0, 1] of the segment between two points
+/// with unit tangents t0, t1 (interpolated; the segment's direction d where
+/// that degenerates).
+inline Vec3f shadingTangent(const Vec3f& t0, const Vec3f& t1, float t, const Vec3f& d) {
+    return normalizeOr((1.0f - t) * t0 + t * t1, d);
+}
+
 /// Summary figures printed by `hairvox info` and recorded as grid metadata.
 struct GroomStats {
     std::size_t strands = 0, points = 0, segments = 0;

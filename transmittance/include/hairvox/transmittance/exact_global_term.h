@@ -15,11 +15,9 @@
 //
 // Self-shadowing: the query point lies on its own fiber, which must not count.
 // The own strand is the query's strand hint or else the strand whose
-// centreline passes within max(D, k·D) of the point. A hit on that strand is
-// the own fiber when the strand runs nearly straight between the point and
-// the hit — arc length ≤ 1.5 × chord + 2(r + k·D) — and is dropped; a curl
-// looping back across the ray (arc length much longer than the chord) is
-// another crossing and counts.
+// centreline passes within max(D, k·D) of the point (RayScene::locate()); its
+// crossings are dropped by RayScene::isOwnFiber() with a slack of
+// 2(r + k·D), while a curl looping back across the ray counts.
 #pragma once
 
 #include <hairvox/strands/groom.h>

@@ -1,0 +1,437 @@
+#include <hairvox/core/error.h>
+#include <hairvox/core/hash.h>
+#include <hairvox/core/interrupt.h>
+#include <hairvox/core/math.h>
+#include <hairvox/core/parallel.h>
+#include <hairvox/core/progress.h>
+#include <hairvox/core/rng.h>
+#include <hairvox/geometry/ray_scene.h>
+#include <hairvox/pathtrace/path_tracer.h>
+#include <hairvox/shading/marschner.h>
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+
+namespace hairvox {
+
+void PathTraceSettings::validate() const {
+    if (spp < 1 || spp > 1'000'000)
+        throw InputError(strCat("path tracing: spp = ", spp, ": expected an integer in [1, 1000000]"));
+    if (!(timeLimit >= 0 && timeLimit <= 1e7))
+        throw InputError(
+            strCat("path tracing: time limit = ", timeLimit, " s: expected a number in [0, 1e7]"));
+    if (maxDepth < 1 || maxDepth > 100'000)
+        throw InputError(strCat("path tracing: max depth = ", maxDepth,
+                                ": expected an integer in [1, 100000]"));
+    if (rouletteDepth < 1 || rouletteDepth > 100'000)
+        throw InputError(strCat("path tracing: roulette depth = ", rouletteDepth,
+                                ": expected an integer in [1, 100000]"));
+}
+
+std::ostream& operator<<(std::ostream& os, const PathTraceSettings& s) {
+    return os << "PathTraceSettings(spp=" << s.spp << ", timeLimit=" << s.timeLimit
+              << " s, maxDepth=" << s.maxDepth << ", rouletteDepth=" << s.rouletteDepth
+              << ", seed=" << s.seed << ")";
+}
+
+std::ostream& operator<<(std::ostream& os, const PathTraceStats& s) {
+    return os << "PathTraceStats(" << s.spp << " spp (" << s.sppThisRun << " this run) in "
+              << s.seconds << " s; " << s.paths << " paths, " << s.rays << " rays, "
+              << s.shadowRays << " shadow rays, " << s.scatteringEvents
+              << " scattering events, deepest " << s.deepestPath << ", " << s.pathsAtDepthCap
+              << " at the depth cap" << (s.timeLimited ? ", time-limited" : "")
+              << (s.interrupted ? ", interrupted" : "") << ")";
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// What one sample contributes, as floats: where each layer's channels are.
+enum Slot : std::size_t {
+    kBeauty = 0,      // RGB
+    kAlpha = 3,       // 1
+    kHairAlpha = 4,   // 1
+    kDirectR = 5,     // RGB
+    kDirectTT = 8,    // RGB
+    kDirectTRT = 11,  // RGB
+    kMultiple = 14,   // RGB
+    kHead = 17,       // RGB
+    kBackground = 20, // RGB
+    kSlots = 23,
+};
+
+/// Film layers of the accumulated slots, in film order.
+struct LayerSlot {
+    const char* name;
+    std::size_t slot;
+    int channels;
+};
+constexpr std::array<LayerSlot, 9> kLayers{{
+    {"", kBeauty, 3},
+    {"A", kAlpha, 1},
+    {"hair.A", kHairAlpha, 1},
+    {"direct_R", kDirectR, 3},
+    {"direct_TT", kDirectTT, 3},
+    {"direct_TRT", kDirectTRT, 3},
+    {"multiple", kMultiple, 3},
+    {"head", kHead, 3},
+    {"background", kBackground, 3},
+}};
+constexpr const char* kHalfLayer = "half_a";
+constexpr const char* kHairHalfLayer = "hair_half_a";
+
+/// Per pixel: the sums of the slots over its samples, and over the samples of
+/// half A the sums of the beauty and of the hair's radiance (direct + multiple).
+struct PixelSums {
+    std::array<double, kSlots> sum{};
+    std::array<double, 3> beautyA{}, hairA{};
+};
+
+struct Sample {
+    std::array<float, kSlots> v{};
+
+    void add(std::size_t slot, const Rgb& c) {
+        v[slot] += c.r;
+        v[slot + 1] += c.g;
+        v[slot + 2] += c.b;
+    }
+    Rgb rgb(std::size_t slot) const { return {v[slot], v[slot + 1], v[slot + 2]}; }
+    Rgb hair() const {
+        return rgb(kDirectR) + rgb(kDirectTT) + rgb(kDirectTRT) + rgb(kMultiple);
+    }
+};
+
+struct Counters {
+    std::uint64_t paths = 0, rays = 0, shadowRays = 0, events = 0, atCap = 0;
+    std::uint32_t deepest = 0;
+    double energyAtCap = 0;
+};
+
+/// A unit vector from the cosine-weighted hemisphere about n (Malley's method).
+Vec3f cosineDirection(const Vec3f& n, float u1, float u2) {
+    const float r = std::sqrt(u1), phi = static_cast<float>(TwoPi) * u2;
+    Vec3f s, t;
+    coordinateSystem(n, s, t);
+    return glm::normalize(r * std::cos(phi) * s + r * std::sin(phi) * t +
+                          std::sqrt(std::max(0.0f, 1.0f - u1)) * n);
+}
+
+/// A surface point's ray offset: off the surface by a small multiple of the
+/// coordinates' magnitude (float resolution there).
+float surfaceOffset(const Vec3f& x) {
+    return 1e-5f * (1.0f + std::max({std::abs(x.x), std::abs(x.y), std::abs(x.z)}));
+}
+
+class Tracer {
+public:
+    Tracer(const PathTraceScene& scene, const PathTraceSettings& settings)
+        : scene_(scene), settings_(settings), camera_(scene.camera), bcsdf_(scene.fiber),
+          rays_(*scene.groom, scene.fiberScale, spheresOf(scene)),
+          slack_(2.0f * scene.fiberScale.ribbonWidth()) {
+        for (const Light& l : scene.lights)
+            if (!l.isDark())
+                lights_.push_back(l);
+    }
+
+    /// Sample `index` of pixel (x, y): samples 2j and 2j + 1 are the j-th of
+    /// halves A and B, two independent randomizations of one sequence.
+    Sample trace(int x, int y, std::uint32_t index, Counters& counters) const {
+        const std::size_t pixel = std::size_t(y) * std::size_t(camera_.width()) + std::size_t(x);
+        Pcg32 rng(Hasher().value(settings_.seed).value(pixel).value(index).digest());
+        Sample out;
+
+        // The pixel position: R2 (Roberts 2018), rotated per pixel and half.
+        const std::uint32_t half = index & 1u;
+        const std::uint64_t rotation = Hasher().value(settings_.seed).value(pixel).value(half).digest();
+        constexpr double a1 = 0.7548776662466927, a2 = 0.5698402909980532;
+        const double r1 = double(rotation & 0xffffffffu) * 0x1p-32;
+        const double r2 = double(rotation >> 32) * 0x1p-32;
+        const double k = double(index >> 1) + 1.0;
+        const Vec2f raster(float(x) + float(std::fmod(r1 + k * a1, 1.0)),
+                           float(y) + float(std::fmod(r2 + k * a2, 1.0)));
+        const Vec3f dirCam = camera_.rayDirection(raster);
+        Vec3f dir = camera_.toWorldDirection(dirCam);
+        // Geometry nearer than the near plane is clipped, as in the rasterizer.
+        Vec3f origin = camera_.position() + (camera_.nearClip() / dirCam.z) * dir;
+
+        ++counters.paths;
+        Rgb throughput(1.0f);
+        bool firstOnHair = false;
+        std::optional<RayOrigin> from;
+        std::uint32_t events = 0;
+        for (;;) {
+            ++counters.rays;
+            const std::optional<RayHit> hit = rays_.intersect(
+                origin, dir, std::numeric_limits<float>::infinity(), from ? &*from : nullptr);
+            if (!hit) {
+                if (events == 0)
+                    out.add(kBackground, scene_.background);
+                break;
+            }
+            const Vec3f xHit = origin + hit->t * dir;
+            const Vec3f wo = -dir;
+            if (events == 0) {
+                firstOnHair = hit->kind == RayHit::Kind::Fiber;
+                out.v[kAlpha] = 1.0f;
+                out.v[kHairAlpha] = firstOnHair ? 1.0f : 0.0f;
+            }
+            // Where this vertex's light goes: depth 1 on hair by lobe, deeper
+            // paths on hair to `multiple`, paths that began on a surface to `head`.
+            const std::size_t deeper = firstOnHair ? kMultiple : kHead;
+            ++events;
+            ++counters.events;
+            if (hit->kind == RayHit::Kind::Fiber) {
+                const Vec3f& u = hit->tangent;
+                const RayOrigin here{hit->fiber, slack_};
+                for (const Light& light : lights_) {
+                    const Light::Path path = light.pathFrom(xHit);
+                    if (!(path.distance > 0))
+                        continue;
+                    const FiberAngles a = FiberAngles::fromDirections(path.omega, wo, u);
+                    if (!(a.cosTheta_i > 0))
+                        continue;
+                    ++counters.shadowRays;
+                    if (rays_.occluded(xHit, path.omega, path.distance, &here))
+                        continue;
+                    const LobeValues f = bcsdf_.eval(a);
+                    const Rgb e = throughput * light.irradiance(path.distance) * a.cosTheta_i;
+                    if (events == 1) {
+                        out.add(kDirectR, e * f.R);
+                        out.add(kDirectTT, e * f.TT);
+                        out.add(kDirectTRT, e * f.TRT);
+                    } else {
+                        out.add(deeper, e * f.sum());
+                    }
+                }
+                const BcsdfSample s = bcsdf_.sample(
+                    wo, u, {rng.uniformFloat(), rng.uniformFloat(), rng.uniformFloat(), rng.uniformFloat()});
+                if (!s.valid())
+                    break;
+                throughput *= s.weight;
+                origin = xHit;
+                dir = s.wi;
+                from = here;
+            } else {
+                const LambertianSphere& surface = scene_.spheres[hit->surface];
+                Vec3f n = hit->normal;
+                if (glm::dot(n, wo) < 0)
+                    n = -n;
+                const Vec3f xOff = xHit + surfaceOffset(xHit) * n;
+                const Rgb brdf = float(InvPi) * surface.albedo;
+                for (const Light& light : lights_) {
+                    const Light::Path path = light.pathFrom(xOff);
+                    const float cosTheta = glm::dot(n, path.omega);
+                    if (!(cosTheta > 0) || !(path.distance > 0))
+                        continue;
+                    ++counters.shadowRays;
+                    if (rays_.occluded(xOff, path.omega, path.distance))
+                        continue;
+                    out.add(deeper, throughput * brdf * light.irradiance(path.distance) * cosTheta);
+                }
+                throughput *= surface.albedo;
+                origin = xOff;
+                dir = cosineDirection(n, rng.uniformFloat(), rng.uniformFloat());
+                from.reset();
+            }
+            if (throughput.isBlack())
+                break;
+            if (events >= settings_.maxDepth) {
+                ++counters.atCap;
+                counters.energyAtCap += double(throughput.average());
+                break;
+            }
+            if (events >= settings_.rouletteDepth) {
+                const float q = std::min(1.0f, throughput.maxComponent());
+                if (rng.uniformFloat() >= q)
+                    break;
+                throughput /= q;
+            }
+        }
+        counters.deepest = std::max(counters.deepest, events);
+        const Rgb beauty = out.rgb(kBackground) + out.rgb(kHead) + out.hair();
+        out.add(kBeauty, beauty);
+        return out;
+    }
+
+    const Camera& camera() const { return camera_; }
+
+private:
+    static std::vector<Sphere> spheresOf(const PathTraceScene& scene) {
+        std::vector<Sphere> spheres;
+        for (const LambertianSphere& s : scene.spheres)
+            spheres.push_back(s.sphere);
+        return spheres;
+    }
+
+    const PathTraceScene& scene_;
+    const PathTraceSettings& settings_;
+    Camera camera_;
+    MarschnerBcsdf bcsdf_;
+    RayScene rays_;
+    float slack_;
+    std::vector<Light> lights_;
+};
+
+/// The sums a film of this function's layers held after `spp` samples (even:
+/// half of them in half A).
+void restoreSums(const Film& film, std::uint32_t spp, std::vector<PixelSums>& sums) {
+    for (const LayerSlot& l : kLayers)
+        if (!film.find(l.name))
+            throw InputError(strCat("the path-traced image to continue has no layer '", l.name, "'"));
+    for (const char* name : {kHalfLayer, kHairHalfLayer})
+        if (!film.find(name))
+            throw InputError(strCat("the path-traced image to continue has no layer '", name, "'"));
+    const double n = spp, nA = spp / 2;
+    const FilmLayer& half = film.layer(kHalfLayer);
+    const FilmLayer& hairHalf = film.layer(kHairHalfLayer);
+    for (std::size_t p = 0; p < sums.size(); ++p) {
+        PixelSums& s = sums[p];
+        for (const LayerSlot& l : kLayers) {
+            const FilmLayer& layer = film.layer(l.name);
+            for (int c = 0; c < l.channels; ++c)
+                s.sum[l.slot + std::size_t(c)] =
+                    n * double(layer.data[p * std::size_t(l.channels) + std::size_t(c)]);
+        }
+        for (std::size_t c = 0; c < 3; ++c) {
+            s.beautyA[c] = nA * double(half.data[3 * p + c]);
+            s.hairA[c] = nA * double(hairHalf.data[3 * p + c]);
+        }
+    }
+}
+
+Film filmOf(int width, int height, const std::vector<PixelSums>& sums, std::uint32_t spp) {
+    Film film(width, height);
+    for (const LayerSlot& l : kLayers)
+        film.addLayer(l.name, l.channels, /*fullPrecision=*/true);
+    film.addLayer(kHalfLayer, 3, true);
+    film.addLayer(kHairHalfLayer, 3, true);
+    if (spp == 0)
+        return film;
+    const double n = spp, nA = spp / 2;
+    std::vector<FilmLayer*> layers;
+    for (const LayerSlot& l : kLayers)
+        layers.push_back(&film.layer(l.name));
+    FilmLayer& half = film.layer(kHalfLayer);
+    FilmLayer& hairHalf = film.layer(kHairHalfLayer);
+    for (std::size_t p = 0; p < sums.size(); ++p) {
+        const PixelSums& s = sums[p];
+        for (std::size_t i = 0; i < kLayers.size(); ++i) {
+            const auto channels = static_cast<std::size_t>(kLayers[i].channels);
+            for (std::size_t c = 0; c < channels; ++c)
+                layers[i]->data[p * channels + c] = static_cast<float>(s.sum[kLayers[i].slot + c] / n);
+        }
+        for (std::size_t c = 0; c < 3; ++c) {
+            half.data[3 * p + c] = static_cast<float>(s.beautyA[c] / nA);
+            hairHalf.data[3 * p + c] = static_cast<float>(s.hairA[c] / nA);
+        }
+    }
+    return film;
+}
+
+} // namespace
+
+PathTraceOutput pathTrace(const PathTraceScene& scene, const PathTraceSettings& settings,
+                          const Film* previous, std::uint32_t previousSpp) {
+    const Clock::time_point start = Clock::now();
+    settings.validate();
+    if (!scene.groom)
+        throw std::invalid_argument("pathTrace: no groom");
+    scene.fiberScale.validate();
+    const ThreadLimit threadLimit(settings.threads);
+    const Tracer tracer(scene, settings);
+    const Camera& camera = tracer.camera();
+    const int width = camera.width(), height = camera.height();
+    const std::size_t pixels = std::size_t(width) * std::size_t(height);
+
+    std::vector<PixelSums> sums(pixels);
+    std::uint32_t spp = 0;
+    if (previous && previousSpp > 0) {
+        if (previousSpp % 2 != 0)
+            throw InputError(strCat("the path-traced image to continue has ", previousSpp,
+                                    " samples per pixel; runs take them in pairs"));
+        if (previous->width() != width || previous->height() != height)
+            throw InputError(strCat("the path-traced image to continue is ", previous->width(), " x ",
+                                    previous->height(), ", the camera ", width, " x ", height));
+        restoreSums(*previous, previousSpp, sums);
+        spp = previousSpp;
+    }
+
+    PathTraceOutput out;
+    PathTraceStats& st = out.stats;
+    tbb::enumerable_thread_specific<Counters> counters;
+    // Passes of two samples per pixel, one in each half.
+    std::vector<std::array<Sample, 2>> pass(pixels);
+    const std::uint32_t target = std::max(settings.spp + (settings.spp & 1u), spp);
+    ProgressReporter progress("path trace", (target - spp) / 2, settings.progress);
+    if (settings.timeLimit > 0)
+        progress.limitTime(settings.timeLimit);
+    constexpr int kRowsPerTask = 4;
+    while (spp < target) {
+        // The time limit ends the run between passes, after the first: an image
+        // of no samples would be of no use.
+        if (settings.timeLimit > 0 && st.sppThisRun > 0 &&
+            std::chrono::duration<double>(Clock::now() - start).count() >= settings.timeLimit) {
+            st.timeLimited = true;
+            break;
+        }
+        try {
+            tbb::parallel_for(
+                tbb::blocked_range<int>(0, height, kRowsPerTask),
+                [&](const tbb::blocked_range<int>& rows) {
+                    throwIfInterrupted();
+                    flushDenormalsToZero();
+                    Counters& c = counters.local();
+                    for (int y = rows.begin(); y != rows.end(); ++y)
+                        for (int x = 0; x < width; ++x) {
+                            auto& samples = pass[std::size_t(y) * std::size_t(width) + std::size_t(x)];
+                            samples[0] = tracer.trace(x, y, spp, c);
+                            samples[1] = tracer.trace(x, y, spp + 1, c);
+                        }
+                });
+        } catch (const Interrupted&) {
+            st.interrupted = true; // the pass is incomplete: dropped
+            break;
+        }
+        tbb::parallel_for(std::size_t(0), pixels, [&](std::size_t p) {
+            PixelSums& s = sums[p];
+            for (const Sample& v : pass[p])
+                for (std::size_t k = 0; k < kSlots; ++k)
+                    s.sum[k] += double(v.v[k]);
+            const Sample& a = pass[p][0];
+            const Rgb beauty = a.rgb(kBeauty), hair = a.hair();
+            for (int c = 0; c < 3; ++c) {
+                s.beautyA[std::size_t(c)] += double(beauty[c]);
+                s.hairA[std::size_t(c)] += double(hair[c]);
+            }
+        });
+        spp += 2;
+        st.sppThisRun += 2;
+        progress.update();
+    }
+    progress.finish();
+
+    st.spp = spp;
+    for (const Counters& c : counters) {
+        st.paths += c.paths;
+        st.rays += c.rays;
+        st.shadowRays += c.shadowRays;
+        st.scatteringEvents += c.events;
+        st.pathsAtDepthCap += c.atCap;
+        st.energyAtDepthCap += c.energyAtCap;
+        st.deepestPath = std::max(st.deepestPath, c.deepest);
+    }
+    if (st.paths > 0)
+        st.energyAtDepthCap /= double(st.paths);
+    out.film = filmOf(width, height, sums, spp);
+    st.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    return out;
+}
+
+} // namespace hairvox
