@@ -124,7 +124,7 @@ struct RenderContext {
         , layout(sh.layout())
         , settings(st)
         , surfaces(su)
-        , fiberRadius(0.5f * st.fiberScale.diameter)
+        , fiberRadius(0.5f * st.fiberScale.ribbonWidth())
         , stride(layout.stride())
         , radianceFloats(layout.radianceFloats()) {}
 
@@ -541,8 +541,7 @@ private:
             st.groupT = st.T;
             st.groupCoverage = f.alpha;
         }
-        const float T =
-            st.groupT * (hair ? hairTransmittance(st.groupCoverage) : 1.0f - st.groupCoverage);
+        const float T = st.groupT * (1.0f - st.groupCoverage);
         const float w = st.T - T; // this fragment's share: what it took from the transmittance
         st.T = T;
         st.lastPoint = point;
@@ -558,13 +557,6 @@ private:
             st.closed = true;
             --openPixels_;
         }
-    }
-
-    /// Transmittance through a strand of coverage α standing for k hairs (the
-    /// density multiplier) at independent positions in the pixel: (1 − α)^k.
-    float hairTransmittance(float alpha) const {
-        const float k = ctx_.settings.fiberScale.densityMultiplier;
-        return k == 1.0f ? 1.0f - alpha : std::exp(k * std::log1p(-alpha));
     }
 
     void finishCoverage() {

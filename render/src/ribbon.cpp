@@ -6,10 +6,9 @@ namespace hairvox::raster {
 
 namespace {
 
-/// Raster-space direction of the projected tangent u at camera-space point pc
-/// (the derivative of Camera::toRaster along u), unnormalised.
-Vec2d projectedTangent(const Vec3f& pc, const Vec3f& uc) {
-    const Vec3d p(pc), u(uc);
+/// Raster-space image of a direction u at camera-space point p (the
+/// derivative of Camera::toRaster along u, divided by the focal length).
+Vec2d projectDirection(const Vec3d& p, const Vec3d& u) {
     return {(u.x * p.z - p.x * u.z) / (p.z * p.z), -(u.y * p.z - p.y * u.z) / (p.z * p.z)};
 }
 
@@ -40,22 +39,28 @@ void ScreenRibbon::locate(const Vec2d& c, float& t, float& depth) const {
 
 namespace {
 
-/// The ribbon's half-width offset at a vertex: perpendicular to the projected
-/// tangent (or to `fallback` when the tangent points at the camera), of
-/// length f · radius / z.
+/// The ribbon's half-width offset at a vertex: the projection of the radius
+/// of the ray-facing ribbon — perpendicular to both the tangent and the line
+/// of sight, what Embree's flat curves are (RayScene) — f · radius / z across
+/// the projected tangent on the optical axis, up to 1/cos of the angle off it
+/// (a pinhole stretches the image radially). A tangent pointing at the camera
+/// takes the perpendicular of `fallback` instead.
 Vec2d ribbonOffset(const Vec3f& pc, const Vec3f& uc, double focal, double radius,
                    const Vec2d& fallback) {
-    Vec2d d = projectedTangent(pc, uc);
-    double len = glm::length(d);
-    if (!(len > 1e-9)) {
-        d = fallback;
-        len = glm::length(d);
-        if (!(len > 1e-12)) {
-            d = Vec2d(1.0, 0.0);
-            len = 1.0;
-        }
+    const Vec3d p(pc), w = glm::cross(p, Vec3d(uc));
+    const double lw = glm::length(w);
+    Vec2d d = projectDirection(p, Vec3d(uc));
+    if (lw > 1e-9 * glm::length(p) && glm::length(d) > 1e-9) {
+        const Vec2d o = projectDirection(p, w) * (focal * radius / lw);
+        return glm::dot(o, Vec2d(-d.y, d.x)) < 0 ? -o : o;
     }
-    return Vec2d(-d.y, d.x) * (focal * radius / (double(pc.z) * len));
+    d = fallback;
+    double len = glm::length(d);
+    if (!(len > 1e-12)) {
+        d = Vec2d(1.0, 0.0);
+        len = 1.0;
+    }
+    return Vec2d(-d.y, d.x) * (focal * radius / (p.z * len));
 }
 
 void setBounds(ScreenRibbon& r) {

@@ -3,9 +3,10 @@
 //
 // The ribbon of segment p0 → p1 (vertex tangents u0, u1) is the quad
 //   A = s0 + o0,  B = s1 + o1,  C = s1 − o1,  D = s0 − o0
-// where s_k is the raster position of p_k and o_k is the perpendicular of
-// p_k's projected tangent scaled to the half-width D/2 · f / z_k, lengthened at
-// a bend to a miter join so that the ribbon is D wide along both segments.
+// where s_k is the raster position of p_k and o_k is the image of the
+// half-width of the ray-facing ribbon at p_k (D/2 across the tangent and the
+// line of sight: the ribbon Embree's flat curves intersect), lengthened at a
+// bend to a miter join so that the ribbon is D wide along both segments.
 // Since o_k depends only on vertex k, consecutive segments of a strand share
 // an edge.
 // A segment crossing the near plane is clipped in 3D first; t0/t1 remember

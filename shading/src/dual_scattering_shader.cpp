@@ -57,7 +57,7 @@ Rgb DualScatteringShader::fBack(const FiberAngles& a, const Rgb& sigma2) const {
 }
 
 Rgb DualScatteringShader::fsScatter(const FiberAngles& a, const Rgb& sigma2_f) const {
-    const LobeValues ng = tables_.NG(a.theta_d);
+    const LobeValues ng = tables_.NG(a.theta_d, a.phi);
     Rgb sum(0.0f);
     for (Lobe p : kLobes) {
         const float beta = bcsdf_.beta(p);

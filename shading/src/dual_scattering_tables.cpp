@@ -16,6 +16,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <optional>
 
@@ -28,7 +29,7 @@ using Sample = DualScatteringTables::Sample;
 namespace {
 
 /// Bumped whenever the integration or the file layout changes: old cache files then miss.
-constexpr std::uint32_t kFormatVersion = 1;
+constexpr std::uint32_t kFormatVersion = 2; // 2: N^G over (θ_d, φ)
 constexpr char kMagic[8] = {'H', 'V', 'X', 'D', 'S', 'T', 'B', 'L'};
 
 /// Eqs. 10–12 are geometric series in ā_f² that diverge as ā_f → 1, which
@@ -44,7 +45,7 @@ struct Field {
     const char* name;
     Rgb Sample::*member;
 };
-constexpr std::array<Field, 12> kFields{{
+constexpr std::array<Field, 9> kFields{{
     {"af", &Sample::aBar_f},
     {"ab", &Sample::aBar_b},
     {"alphaf", &Sample::alphaBar_f},
@@ -54,11 +55,10 @@ constexpr std::array<Field, 12> kFields{{
     {"Ab", &Sample::ABar_b},
     {"Deltab", &Sample::DeltaBar_b},
     {"sigma2b", &Sample::sigma2Bar_b},
-    {"NGR", &Sample::NG_R},
-    {"NGTT", &Sample::NG_TT},
-    {"NGTRT", &Sample::NG_TRT},
 }};
-constexpr std::size_t kFloatsPerRow = kFields.size() * 3;
+constexpr int kNGPhi = DualScatteringTables::kNGPhiSamples;
+/// Floats per θ row in the cache file: the fields, then N^G per φ and lobe.
+constexpr std::size_t kFloatsPerRow = kFields.size() * 3 + std::size_t(kNGPhi) * 9;
 
 void requireRange(const char* name, double value, double lo, double hi) {
     if (!(value >= lo && value <= hi))
@@ -68,37 +68,41 @@ void requireRange(const char* name, double value, double lo, double hi) {
 
 // ---- azimuthal integrals ----------------------------------------------------
 
+/// ∫ N_p dφ over the half circle |wrap(φ − μ)| < π/2 centred on an azimuth μ,
+/// and over the other half. Centred on μ = 0 they are the back half Ω_b and
+/// the front half Ω_f.
 struct Halves {
-    Rgbd back, front; ///< ∫ over |φ| < π/2 and |φ| ≥ π/2
+    Rgbd inside, outside;
 
     Halves& operator+=(const Halves& o) {
-        back += o.back;
-        front += o.front;
+        inside += o.inside;
+        outside += o.outside;
         return *this;
     }
-    friend Halves operator*(double s, const Halves& h) { return {s * h.back, s * h.front}; }
+    friend Halves operator*(double s, const Halves& h) { return {s * h.inside, s * h.outside}; }
 };
 
-/// ∫_{−π/2}^{π/2} g(wrap(φ − μ); w) dφ: the part of a wrapped-difference
-/// Gaussian lobe at μ that falls in the back half.
-double backMassOfLobe(double mu, double w) {
+/// ∫_{μ−π/2}^{μ+π/2} g(wrap(φ − ν); w) dφ: the part of a wrapped-difference
+/// Gaussian lobe at ν that falls in the half circle centred on μ.
+double lobeMassInHalf(double nu, double w, double mu) {
     const auto cdf = [w](double x) {
         return 0.5 * std::erfc(-x / (w * std::sqrt(2.0)));
     };
+    const double offset = wrapAngle(nu - mu);
     double mass = 0;
     for (int k = -1; k <= 1; ++k) {
-        const double lo = std::max(-PiOver2 - mu + TwoPi * k, -Pi);
-        const double hi = std::min(PiOver2 - mu + TwoPi * k, Pi);
+        const double lo = std::max(-PiOver2 - offset + TwoPi * k, -Pi);
+        const double hi = std::min(PiOver2 - offset + TwoPi * k, Pi);
         if (hi > lo)
             mass += cdf(hi) - cdf(lo);
     }
     return mass;
 }
 
-/// ∫ N_p(θ_d, φ) dφ over each half for the index η (η* for eccentric TRT),
-/// as ½ ∫ A_p(h)·fade dh with h = sin γ over the γ-pieces between the
-/// points where the exit azimuth crosses ±π/2.
-Halves integrateAzimuth(int p, const FiberParams& params, double eta, double theta_d,
+/// ∫ N_p(θ_d, φ) dφ over the half circle centred on μ and over the rest, for
+/// the index η (η* for eccentric TRT), as ½ ∫ A_p(h)·fade dh with h = sin γ
+/// over the γ-pieces between the points where the exit azimuth crosses μ ± π/2.
+Halves integrateAzimuth(int p, const FiberParams& params, double eta, double theta_d, double mu,
                         const GaussLegendre& gl) {
     const azimuthal::Geometry geo = azimuthal::Geometry::make(eta, theta_d);
     azimuthal::TrtCaustic caustic;
@@ -110,7 +114,7 @@ Halves integrateAzimuth(int p, const FiberParams& params, double eta, double the
     cuts.fill(PiOver2);
     cuts[0] = -PiOver2;
     std::size_t cutCount = 1;
-    for (double boundary : {PiOver2, -PiOver2}) {
+    for (double boundary : {wrapAngle(mu + PiOver2), wrapAngle(mu - PiOver2)}) {
         const azimuthal::Roots roots = azimuthal::solveExitAzimuth(p, boundary, geo.etaPrime);
         for (int k = 0; k < roots.count; ++k)
             cuts[cutCount++] = roots.gamma_i[static_cast<std::size_t>(k)];
@@ -125,35 +129,35 @@ Halves integrateAzimuth(int p, const FiberParams& params, double eta, double the
         const double a = cuts[k], b = cuts[k + 1];
         if (!(b - a > 1e-14))
             continue;
-        const bool front = std::cos(exitPhi(0.5 * (a + b))) < 0;
+        const bool inside = std::cos(exitPhi(0.5 * (a + b)) - mu) > 0;
         const Rgbd piece = gl.integrate<Rgbd>(a, b, [&](double gamma) {
             double weight = 0.5 * std::cos(gamma);
             if (p == 2)
                 weight *= azimuthal::trtFade(caustic, exitPhi(gamma));
             return weight * azimuthal::attenuation(p, geo, gamma, params.sigma_a);
         });
-        (front ? halves.front : halves.back) += piece;
+        (inside ? halves.inside : halves.outside) += piece;
     }
     if (p == 2 && caustic.t > 0) {
         const double w = caustic.width;
         const double total = 2 * std::erf(Pi / (w * std::sqrt(2.0)));
-        const double back = backMassOfLobe(caustic.phi_c, w) + backMassOfLobe(-caustic.phi_c, w);
-        halves.back += back * caustic.amplitude;
-        halves.front += (total - back) * caustic.amplitude;
+        const double in = lobeMassInHalf(caustic.phi_c, w, mu) + lobeMassInHalf(-caustic.phi_c, w, mu);
+        halves.inside += in * caustic.amplitude;
+        halves.outside += (total - in) * caustic.amplitude;
     }
     return halves;
 }
 
 /// The same, averaged over the cross-section orientation for eccentric TRT.
-Halves integrateAzimuth(int p, const FiberParams& params, double theta_d, const GaussLegendre& gl,
-                        const GaussLegendre& eccentricGl) {
+Halves integrateAzimuth(int p, const FiberParams& params, double theta_d, double mu,
+                        const GaussLegendre& gl, const GaussLegendre& eccentricGl) {
     if (p != 2 || params.eccentricity == 1.0f)
-        return integrateAzimuth(p, params, params.eta, theta_d, gl);
+        return integrateAzimuth(p, params, params.eta, theta_d, mu, gl);
     // φ_h uniform: over [0, π/2] cos 2φ_h takes every value once.
     return eccentricGl.integrate<Halves>(0, PiOver2, [&](double phi_h) {
         const double eta =
             azimuthal::eccentricEta(params.eta, params.eccentricity, std::cos(2 * phi_h));
-        return (1 / PiOver2) * integrateAzimuth(p, params, eta, theta_d, gl);
+        return (1 / PiOver2) * integrateAzimuth(p, params, eta, theta_d, mu, gl);
     });
 }
 
@@ -191,19 +195,16 @@ Sample buildRow(const FiberParams& params, const TableBuildOptions& options, dou
                 const double cosO = std::cos(theta_o), cosD = std::cos(theta_d);
                 const double m = longitudinalLobe(theta_h - alpha[p], beta[p] * beta[p]);
                 return (m * cosO * cosO / (cosD * cosD)) *
-                       integrateAzimuth(static_cast<int>(p), params, theta_d, gl, eccentricGl);
+                       integrateAzimuth(static_cast<int>(p), params, theta_d, 0.0, gl,
+                                        eccentricGl);
             });
         }
     }
-    std::array<Halves, 3> ng;
-    for (std::size_t p = 0; p < 3; ++p)
-        ng[p] = integrateAzimuth(static_cast<int>(p), params, theta, gl, eccentricGl);
-
     Sample s;
     for (int c = 0; c < 3; ++c) {
         double aF = 0, aB = 0, alphaF = 0, alphaB = 0, beta2F = 0, beta2B = 0;
         for (std::size_t p = 0; p < 3; ++p) {
-            const double wF = lobe[p].front[c], wB = lobe[p].back[c];
+            const double wF = lobe[p].outside[c], wB = lobe[p].inside[c];
             aF += wF;
             aB += wB;
             alphaF += wF * alpha[p];
@@ -239,11 +240,20 @@ Sample buildRow(const FiberParams& params, const TableBuildOptions& options, dou
         s.ABar_b[c] = static_cast<float>(ABar);
         s.DeltaBar_b[c] = static_cast<float>(DeltaBar);
         s.sigma2Bar_b[c] = static_cast<float>(sigma2Bar_b(aF, aB, beta2F, beta2B, options.d_b));
-        s.NG_R[c] = static_cast<float>(ng[0].front[c] / Pi);
-        s.NG_TT[c] = static_cast<float>(ng[1].front[c] / Pi);
-        s.NG_TRT[c] = static_cast<float>(ng[2].front[c] / Pi);
     }
     return s;
+}
+
+/// N^G_p(θ_d, φ_j) = (1/π) ∫_{φ_j−π/2}^{φ_j+π/2} N_p(θ_d, φ') dφ' for every tabulated φ_j.
+void buildNG(const FiberParams& params, double theta_d, const GaussLegendre& gl,
+             const GaussLegendre& eccentricGl, LobeValues* out) {
+    for (int j = 0; j < kNGPhi; ++j) {
+        const double phi = Pi * double(j) / double(kNGPhi - 1);
+        for (Lobe p : kLobes)
+            out[j][p] = Rgb((1 / Pi) * integrateAzimuth(static_cast<int>(p), params, theta_d, phi,
+                                                        gl, eccentricGl)
+                                           .inside);
+    }
 }
 
 std::uint64_t computeCacheKey(const FiberParams& params, const TableBuildOptions& options) {
@@ -299,6 +309,7 @@ DualScatteringTables DualScatteringTables::build(const FiberParams& params,
     t.cacheKey_ = computeCacheKey(params, options);
     const auto n = static_cast<std::size_t>(options.thetaSamples);
     t.rows_.resize(n);
+    t.ng_.resize(n * std::size_t(kNGPhi));
     t.invStep_ = static_cast<float>(double(n - 1) / Pi);
     t.lastIndex_ = static_cast<float>(n - 1);
 
@@ -307,8 +318,9 @@ DualScatteringTables DualScatteringTables::build(const FiberParams& params,
     const auto buildRows = [&](std::size_t begin, std::size_t end) {
         for (std::size_t k = begin; k < end; ++k) {
             throwIfInterrupted();
-            t.rows_[k] =
-                buildRow(params, options, double(t.theta(static_cast<int>(k))), gl, eccentricGl);
+            const double theta = double(t.theta(static_cast<int>(k)));
+            t.rows_[k] = buildRow(params, options, theta, gl, eccentricGl);
+            buildNG(params, theta, gl, eccentricGl, &t.ng_[k * std::size_t(kNGPhi)]);
         }
     };
     if (options.threaded)
@@ -331,9 +343,23 @@ Sample DualScatteringTables::lookup(float theta) const {
     return s;
 }
 
-LobeValues DualScatteringTables::NG(float theta_d) const {
-    const auto [R, TT, TRT] = interpolate(theta_d, &Sample::NG_R, &Sample::NG_TT, &Sample::NG_TRT);
-    return {R, TT, TRT};
+LobeValues DualScatteringTables::NG(float theta_d, float phi) const {
+    const auto [k, t] = locate(theta_d);
+    float x = std::abs(wrapAngle(phi)) * float(double(kNGPhi - 1) / Pi);
+    x = x > 0 ? std::min(x, float(kNGPhi - 1)) : 0.0f; // !(x > 0) also catches NaN
+    const int j = std::min(static_cast<int>(x), kNGPhi - 2);
+    const float s = x - float(j);
+    const int row = static_cast<int>(k);
+    const LobeValues& a0 = NGSample(row, j);
+    const LobeValues& a1 = NGSample(row, j + 1);
+    const LobeValues& b0 = NGSample(row + 1, j);
+    const LobeValues& b1 = NGSample(row + 1, j + 1);
+    LobeValues v;
+    for (Lobe p : kLobes) {
+        const Rgb a = a0[p] + s * (a1[p] - a0[p]), b = b0[p] + s * (b1[p] - b0[p]);
+        v[p] = a + t * (b - a);
+    }
+    return v;
 }
 
 DualScatteringTables DualScatteringTables::withBackwardDensity(float d_b) const {
@@ -358,6 +384,11 @@ void DualScatteringTables::writeCsv(const fs::path& path) const {
         for (const Field& f : kFields)
             for (const char* ch : {"_r", "_g", "_b"})
                 out << ',' << f.name << ch;
+        for (const char* lobe : {"NGR", "NGTT", "NGTRT"})
+            for (int j = 0; j < kNGPhi; ++j)
+                for (const char* ch : {"_r", "_g", "_b"})
+                    out << ',' << lobe << "_phi" << std::setw(3) << std::setfill('0')
+                        << (180 * j) / (kNGPhi - 1) << ch;
         out << '\n';
         out.precision(9);
         for (int k = 0; k < size(); ++k) {
@@ -366,6 +397,11 @@ void DualScatteringTables::writeCsv(const fs::path& path) const {
                 const Rgb& v = sample(k).*f.member;
                 out << ',' << v.r << ',' << v.g << ',' << v.b;
             }
+            for (Lobe p : kLobes)
+                for (int j = 0; j < kNGPhi; ++j) {
+                    const Rgb& v = NGSample(k, j)[p];
+                    out << ',' << v.r << ',' << v.g << ',' << v.b;
+                }
             out << '\n';
         }
         out.flush();
@@ -375,8 +411,9 @@ void DualScatteringTables::writeCsv(const fs::path& path) const {
 }
 
 /// Binary cache layout (host byte order; a cache is local to the machine):
-/// magic[8], u32 format version, u32 θ samples, u64 key, f32 rows[n][36],
-/// u64 checksum of everything before it.
+/// magic[8], u32 format version, u32 θ samples, u64 key, f32 rows[n][27 +
+/// 37·9] (the fields, then N^G per φ and lobe), u64 checksum of everything
+/// before it.
 struct TableIo {
     static constexpr std::size_t kHeaderSize = 8 + 4 + 4 + 8;
 
@@ -392,13 +429,18 @@ struct TableIo {
         put(&kFormatVersion, 4);
         put(&n, 4);
         put(&t.cacheKey_, 8);
-        for (const Sample& s : t.rows_)
-            for (const Field& f : kFields) {
-                const Rgb& v = s.*f.member;
-                put(&v.r, 4);
-                put(&v.g, 4);
-                put(&v.b, 4);
-            }
+        const auto putRgb = [&](const Rgb& v) {
+            put(&v.r, 4);
+            put(&v.g, 4);
+            put(&v.b, 4);
+        };
+        for (int k = 0; k < t.size(); ++k) {
+            for (const Field& f : kFields)
+                putRgb(t.sample(k).*f.member);
+            for (int j = 0; j < kNGPhi; ++j)
+                for (Lobe lobe : kLobes)
+                    putRgb(t.NGSample(k, j)[lobe]);
+        }
         const std::uint64_t checksum =
             Hasher().bytes(bytes.data(), static_cast<std::size_t>(p - bytes.data())).digest();
         put(&checksum, 8);
@@ -433,19 +475,26 @@ struct TableIo {
         t.options_ = options;
         t.cacheKey_ = key;
         t.rows_.resize(n);
+        t.ng_.resize(n * std::size_t(kNGPhi));
         t.invStep_ = static_cast<float>(double(n - 1) / Pi);
         t.lastIndex_ = static_cast<float>(n - 1);
         p += kHeaderSize;
-        for (Sample& s : t.rows_)
-            for (const Field& f : kFields) {
-                Rgb& v = s.*f.member;
-                std::memcpy(&v.r, p, 4);
-                std::memcpy(&v.g, p + 4, 4);
-                std::memcpy(&v.b, p + 8, 4);
-                p += 12;
-                if (!v.isFinite())
+        const auto getRgb = [&p](Rgb& v) {
+            std::memcpy(&v.r, p, 4);
+            std::memcpy(&v.g, p + 4, 4);
+            std::memcpy(&v.b, p + 8, 4);
+            p += 12;
+            return v.isFinite();
+        };
+        for (std::size_t k = 0; k < n; ++k) {
+            for (const Field& f : kFields)
+                if (!getRgb(t.rows_[k].*f.member))
                     return std::nullopt;
-            }
+            for (std::size_t j = 0; j < std::size_t(kNGPhi); ++j)
+                for (Lobe lobe : kLobes)
+                    if (!getRgb(t.ng_[k * std::size_t(kNGPhi) + j][lobe]))
+                        return std::nullopt;
+        }
         return t;
     }
 };

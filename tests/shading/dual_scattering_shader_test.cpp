@@ -67,9 +67,10 @@ TEST(DualScatteringShader, UnshadowedIsSingleScatteringPlusLocalBackscatter) {
         EXPECT_EQ(r.directR, fs.R * a.cosTheta_i);
         EXPECT_EQ(r.directTT, fs.TT * a.cosTheta_i);
         EXPECT_EQ(r.directTRT, fs.TRT * a.cosTheta_i);
-        EXPECT_EQ(r.backDirect, back * (0.7f * a.cosTheta_i));
+        const float d_b = DualScatteringParams{}.d_b;
+        EXPECT_EQ(r.backDirect, back * (d_b * a.cosTheta_i));
         EXPECT_EQ(r.scatter, Rgb(0.0f));
-        const Rgb expected = (fs.sum() + 0.7f * back) * a.cosTheta_i;
+        const Rgb expected = (fs.sum() + d_b * back) * a.cosTheta_i;
         EXPECT_NEAR(r.total().g, expected.g, 1e-5f * expected.g + 1e-9f);
     }
 }
@@ -128,7 +129,7 @@ TEST(DualScatteringShader, ScatteredSpreadKeepsEnergyAndWidens) {
             energy += v * double(a.cos2Theta_d) * Pi / n; // undo 1/cos²θ_d: Σ N^G_p remains
             peak = std::max(peak, v);
         }
-        const LobeValues ng = f.tables.NG(0.5f * (0.0f - theta_i)); // θ_d at the lobe peaks, roughly
+        const LobeValues ng = f.tables.NG(0.5f * (0.0f - theta_i), phi); // θ_d at the lobe peaks, roughly
         EXPECT_NEAR(energy, double(ng.sum().g), 0.03 * double(ng.sum().g)) << sigma2;
         EXPECT_LT(peak, previousPeak);
         previousPeak = peak;
@@ -175,14 +176,14 @@ TEST(DualScatteringShader, ShadeComponentsAreWeighted) {
     const FiberAngles a = FiberAngles::fromDirections(wi, wo, u);
     const Rgb scatter = g.T_s *
                         (f.shader.fsScatter(a, g.sigma2_f) +
-                         static_cast<float>(Pi) * 0.7f * f.shader.fBack(a, g.sigma2_f)) *
+                         static_cast<float>(Pi) * DualScatteringParams{}.d_b * f.shader.fBack(a, g.sigma2_f)) *
                         a.cosTheta_i;
     EXPECT_NEAR(half.scatter.b, scatter.b, 1e-6f * scatter.b);
     EXPECT_GT(half.scatter.r, half.scatter.b);
 }
 
 TEST(DualScatteringShader, UsesItsOwnBackwardDensity) {
-    // Tables built with d_b = 0.7 and a shader with d_b = 0.2: σ̄_b² follows the shader.
+    // Tables built with the default d_b and a shader with d_b = 0.2: σ̄_b² follows the shader.
     const FiberParams p;
     const MarschnerBcsdf bcsdf(p);
     const DualScatteringTables tables = DualScatteringTables::build(p);

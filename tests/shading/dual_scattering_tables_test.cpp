@@ -25,7 +25,7 @@ using Sample = DualScatteringTables::Sample;
 const std::vector<Rgb Sample::*> kAllFields{
     &Sample::aBar_f,     &Sample::aBar_b,     &Sample::alphaBar_f, &Sample::alphaBar_b,
     &Sample::beta2Bar_f, &Sample::beta2Bar_b, &Sample::ABar_b,     &Sample::DeltaBar_b,
-    &Sample::sigma2Bar_b, &Sample::NG_R,      &Sample::NG_TT,      &Sample::NG_TRT};
+    &Sample::sigma2Bar_b};
 
 std::string readFile(const std::filesystem::path& path) {
     std::ifstream in(path, std::ios::binary);
@@ -63,12 +63,17 @@ TEST(DualScatteringTables, QuadratureConverges) {
         options.quadratureOrder = order;
         const DualScatteringTables t = DualScatteringTables::build(params, options);
         double worst = 0;
-        for (int k = 0; k < t.size(); ++k)
-            for (auto field : {&Sample::aBar_f, &Sample::aBar_b, &Sample::NG_R, &Sample::NG_TT,
-                               &Sample::NG_TRT, &Sample::ABar_b})
+        for (int k = 0; k < t.size(); ++k) {
+            for (auto field : {&Sample::aBar_f, &Sample::aBar_b, &Sample::ABar_b})
                 for (int c = 0; c < 3; ++c)
                     worst = std::max(worst, std::abs(double((t.sample(k).*field)[c]) -
                                                      double((reference.sample(k).*field)[c])));
+            for (int j = 0; j < DualScatteringTables::kNGPhiSamples; ++j)
+                for (Lobe p : kLobes)
+                    for (int c = 0; c < 3; ++c)
+                        worst = std::max(worst, std::abs(double(t.NGSample(k, j)[p][c]) -
+                                                         double(reference.NGSample(k, j)[p][c])));
+        }
         RecordProperty("order_" + std::to_string(order), std::to_string(worst));
         EXPECT_LT(worst, previous) << "order " << order;
         if (order >= 24) {
@@ -147,9 +152,6 @@ TEST(DualScatteringTables, BackscatteringTermsFiniteAndPlausible) {
                         ASSERT_GE(std::sqrt(s.sigma2Bar_b[c]), std::sqrt(s.beta2Bar_b[c]) * 0.999f) << s;
                         ASSERT_LT(s.sigma2Bar_b[c], 25.0f) << s;
                         ASSERT_LE(std::abs(s.DeltaBar_b[c]), static_cast<float>(PiOver2)) << s;
-                        ASSERT_GE(s.NG_R[c], 0.0f);
-                        ASSERT_GE(s.NG_TT[c], 0.0f);
-                        ASSERT_GE(s.NG_TRT[c], 0.0f);
                         // Averages of α_p and β_p² lie between the lobes' values.
                         const float a = std::abs(p.alpha_R) * 1.5f + 1e-6f;
                         ASSERT_LE(std::abs(s.alphaBar_f[c]), a);
@@ -161,23 +163,60 @@ TEST(DualScatteringTables, BackscatteringTermsFiniteAndPlausible) {
             }
 }
 
-TEST(DualScatteringTables, FrontAveragedAzimuthalFunctionsMatchDefinition) {
-    // N^G_p(θ_d) = (2/π) ∫_{π/2}^{π} N_p(θ_d, φ') dφ', by the midpoint rule on the exact N_p.
-    const FiberParams params;
+TEST(DualScatteringTables, NGIsNpAveragedOverTheHalfCircleFacingTheLight) {
+    // N^G_p(θ_d, φ) = (1/π) ∫_{φ−π/2}^{φ+π/2} N_p(θ_d, φ') dφ', by the midpoint
+    // rule on the exact N_p (between and on the table's φ samples); at φ = π
+    // it is the printed (2/π) ∫_{π/2}^{π} N_p, and over the circle it carries
+    // N_p's own energy — the printed constant applied at every φ carries twice
+    // the front half's.
+    FiberParams params;
+    params.eccentricity = 0.9f; // the φ_h average and the caustic fade too
     const DualScatteringTables t = DualScatteringTables::build(params);
     const MarschnerBcsdf bcsdf(params);
     for (double theta_d : {0.0, 0.3, 0.8, 1.2}) {
-        LobeValues mean;
-        const int n = 20000;
-        for (int k = 0; k < n; ++k) {
-            const double phi = PiOver2 + PiOver2 * (k + 0.5) / n;
-            const LobeValues v = bcsdf.NExact(theta_d, phi);
+        const auto window = [&](double phi) {
+            LobeValues mean;
+            const int n = 4000;
+            for (int k = 0; k < n; ++k) {
+                const double phi_k = phi - PiOver2 + Pi * (k + 0.5) / n;
+                LobeValues v;
+                const int orientations = 16; // φ_h uniform, for the eccentric TRT
+                for (int o = 0; o < orientations; ++o) {
+                    const LobeValues w =
+                        bcsdf.NExact(theta_d, phi_k, std::cos(Pi * (o + 0.5) / orientations));
+                    for (Lobe p : kLobes)
+                        v[p] += w[p] * static_cast<float>(1.0 / orientations);
+                }
+                for (Lobe p : kLobes)
+                    mean[p] += v[p] * static_cast<float>(1.0 / n);
+            }
+            return mean;
+        };
+        double energy[3] = {0, 0, 0}, total[3] = {0, 0, 0};
+        for (double phi : {0.0, 0.4, Pi / 2, 2.0, 2.6, Pi}) {
+            const LobeValues expected = window(phi);
+            const LobeValues ng = t.NG(static_cast<float>(theta_d), static_cast<float>(phi));
             for (Lobe p : kLobes)
-                mean[p] += v[p] * static_cast<float>(1.0 / n);
+                EXPECT_NEAR(ng[p].g, expected[p].g, 3e-3f * expected.sum().g + 1e-6f)
+                    << int(p) << " θ_d " << theta_d << " φ " << phi;
         }
-        const LobeValues ng = t.NG(static_cast<float>(theta_d));
+        // Energy: 2 ∫_0^π N^G dφ (trapezoid on the table) against 2 ∫_0^π N_p dφ.
+        const int m = 720;
+        for (int k = 0; k <= m; ++k) {
+            const double phi = Pi * k / m, w = (k == 0 || k == m ? 0.5 : 1.0) * 2 * Pi / m;
+            const LobeValues ng = t.NG(static_cast<float>(theta_d), static_cast<float>(phi));
+            for (int o = 0; o < 16; ++o) { // φ_h uniform
+                const LobeValues n = bcsdf.N(static_cast<float>(theta_d), static_cast<float>(phi),
+                                             static_cast<float>(std::cos(Pi * (o + 0.5) / 16)));
+                for (Lobe p : kLobes)
+                    total[int(p)] += w / 16 * double(n[p].g);
+            }
+            for (Lobe p : kLobes)
+                energy[int(p)] += w * double(ng[p].g);
+        }
         for (Lobe p : kLobes)
-            EXPECT_NEAR(ng[p].g, mean[p].g, 2e-3f * mean.sum().g + 1e-6f) << int(p) << " " << theta_d;
+            EXPECT_NEAR(energy[int(p)], total[int(p)], 0.01 * total[int(p)] + 1e-6)
+                << int(p) << " θ_d " << theta_d;
     }
 }
 
@@ -230,8 +269,17 @@ TEST(DualScatteringTables, LookupInterpolatesAndClamps) {
     EXPECT_EQ(t.aBar_f(-5.0f), t.sample(0).aBar_f);
     EXPECT_EQ(t.aBar_f(5.0f), t.sample(6).aBar_f);
     EXPECT_TRUE(t.aBar_f(std::numeric_limits<float>::quiet_NaN()).isFinite());
-    const LobeValues ng = t.NG(t.theta(4));
-    EXPECT_EQ(ng.TT, t.sample(4).NG_TT);
+    for (int j = 0; j < DualScatteringTables::kNGPhiSamples; ++j) {
+        const float phi = static_cast<float>(Pi * j / (DualScatteringTables::kNGPhiSamples - 1));
+        for (float sign : {1.0f, -1.0f}) {
+            const LobeValues ng = t.NG(t.theta(4), sign * phi);
+            for (int c = 0; c < 3; ++c)
+                EXPECT_NEAR(ng.TT[c], t.NGSample(4, j).TT[c], 1e-5f * t.NGSample(4, j).TT[c] + 1e-9f);
+        }
+    }
+    EXPECT_TRUE(t.NG(std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::quiet_NaN())
+                    .sum()
+                    .isFinite());
 }
 
 TEST(DualScatteringTables, DeterministicForAnyThreadCount) {
@@ -371,8 +419,7 @@ std::vector<std::string> csvLines(const std::filesystem::path& path) {
 constexpr const char* kHeader =
     "theta,af_r,af_g,af_b,ab_r,ab_g,ab_b,alphaf_r,alphaf_g,alphaf_b,alphab_r,alphab_g,alphab_b,"
     "beta2f_r,beta2f_g,beta2f_b,beta2b_r,beta2b_g,beta2b_b,Ab_r,Ab_g,Ab_b,Deltab_r,Deltab_g,"
-    "Deltab_b,sigma2b_r,sigma2b_g,sigma2b_b,NGR_r,NGR_g,NGR_b,NGTT_r,NGTT_g,NGTT_b,NGTRT_r,"
-    "NGTRT_g,NGTRT_b";
+    "Deltab_b,sigma2b_r,sigma2b_g,sigma2b_b";
 
 TEST(DualScatteringTables, WritesCsv) {
     test::TempDir dir;
@@ -382,15 +429,21 @@ TEST(DualScatteringTables, WritesCsv) {
     t.writeCsv(dir / "t.csv");
     const std::vector<std::string> lines = csvLines(dir / "t.csv");
     ASSERT_EQ(lines.size(), 6u);
-    EXPECT_EQ(lines[0], kHeader);
+    std::string header = kHeader;
+    for (const char* lobe : {"NGR", "NGTT", "NGTRT"})
+        for (int deg = 0; deg <= 180; deg += 5)
+            for (const char* c : {"_r", "_g", "_b"})
+                header += strCat(",", lobe, "_phi", deg < 100 ? "0" : "", deg < 10 ? "0" : "", deg, c);
+    EXPECT_EQ(lines[0], header);
     std::istringstream row(lines[3]);
     std::vector<double> values;
     for (std::string cell; std::getline(row, cell, ',');)
         values.push_back(std::stod(cell));
-    ASSERT_EQ(values.size(), 37u);
+    ASSERT_EQ(values.size(), 28u + 3u * 37u * 3u);
     EXPECT_NEAR(values[0], 0.0, 1e-7);
     EXPECT_NEAR(values[1], t.sample(2).aBar_f.r, 1e-6);
-    EXPECT_NEAR(values[36], t.sample(2).NG_TRT.b, 1e-6);
+    EXPECT_NEAR(values[28 + 37 * 3 + 36 * 3 + 1], t.NGSample(2, 36).TT.g, 1e-6); // TT at φ = π
+    EXPECT_NEAR(values.back(), t.NGSample(2, 36).TRT.b, 1e-6);
 }
 
 TEST(TablesCli, WritesCsvAndUsesCache) {
@@ -402,7 +455,12 @@ TEST(TablesCli, WritesCsvAndUsesCache) {
     EXPECT_NE(r.output.find("built in"), std::string::npos) << r.output;
     const std::vector<std::string> lines = csvLines(dir / "t.csv");
     ASSERT_EQ(lines.size(), 20u);
-    EXPECT_EQ(lines[0], kHeader);
+    std::string header = kHeader;
+    for (const char* lobe : {"NGR", "NGTT", "NGTRT"})
+        for (int deg = 0; deg <= 180; deg += 5)
+            for (const char* c : {"_r", "_g", "_b"})
+                header += strCat(",", lobe, "_phi", deg < 100 ? "0" : "", deg < 10 ? "0" : "", deg, c);
+    EXPECT_EQ(lines[0], header);
     r = test::runHairvox(common + " --melanin 0.5,0.2 --alpha-r -5 --beta-r 6 --eccentricity 0.9");
     ASSERT_EQ(r.exitCode, 0) << r.output;
     EXPECT_NE(r.output.find("loaded from the cache"), std::string::npos) << r.output;

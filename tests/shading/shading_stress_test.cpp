@@ -110,7 +110,8 @@ TEST(ShadingStressSlow, EveryOutputFiniteAndNonNegative) {
             const DualScatteringTables::Sample s = tables.lookup(theta);
             ASSERT_TRUE(finiteNonNegative(s.aBar_f) && finiteNonNegative(s.aBar_b) &&
                         finiteNonNegative(s.ABar_b) && finiteNonNegative(s.sigma2Bar_b) &&
-                        finiteNonNegative(s.beta2Bar_f) && finiteNonNegative(s.NG_TRT))
+                        finiteNonNegative(s.beta2Bar_f) &&
+                        finiteNonNegative(tables.NG(theta, 3.0f * theta).sum()))
                 << s;
             ASSERT_TRUE(s.DeltaBar_b.isFinite() && s.alphaBar_f.isFinite()) << s;
             ASSERT_TRUE(finiteNonNegative(tables.aBar_f(theta)) && finiteNonNegative(tables.beta2Bar_f(theta)));

@@ -12,9 +12,8 @@
 // broken by segment index); fragments of adjacent segments of one strand that
 // follow each other add their coverage (they tile the ribbon) instead of
 // compositing over each other. A strand standing for k hairs (the density
-// multiplier, strands/fiber_scale.h) that covers α of a pixel transmits
-// (1 − α)^k — k hairs at independent positions, as the global term counts
-// them. A pixel is opaque once its transmittance falls to
+// multiplier, strands/fiber_scale.h) is a ribbon k·D wide, the ribbon exact
+// mode and the path tracer meet. A pixel is opaque once its transmittance falls to
 // RasterSettings::opaqueTransmittance: fragments behind it are never shaded,
 // and since segments are rasterized nearest first, most of them are not even
 // generated (docs/DESIGN.md §7).

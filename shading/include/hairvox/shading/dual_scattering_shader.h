@@ -6,11 +6,11 @@
 //   F_scatter = T_s·(f_s^scatter + π·d_b·f_back^scatter)
 //   result    = (F_direct + F_scatter)·cos θ_i
 //
-// with, at θ = θ_i for the table entries and θ_d for N^G:
+// with, at θ = θ_i for the table entries and (θ_d, φ) for N^G:
 //   f_back^direct  = Ā_b·S̄_b(θ_h, φ; σ̄_b²)/cos²θ_d
 //   f_back^scatter = Ā_b·S̄_b(θ_h, φ; σ̄_b² + σ_f²)/cos²θ_d
 //   S̄_b(θ_h, φ; σ²) = ½·g(θ_h − Δ̄_b; σ) · ½·max(cos φ, 0)
-//   f_s^scatter    = Σ_p ½·g(θ_h − α_p; sqrt(β_p² + σ_f²))·N^G_p(θ_d)/cos²θ_d
+//   f_s^scatter    = Σ_p ½·g(θ_h − α_p; sqrt(β_p² + σ_f²))·N^G_p(θ_d, φ)/cos²θ_d
 //
 // Decisions (each a departure from the printed text, see DESIGN.md §5):
 //  - The report's Eqs. 19 and 20 are swapped relative to its own pseudocode
@@ -30,6 +30,11 @@
 //    the view crosses the light's terminator.
 //  - f_s^scatter carries the same 1/cos²θ_d as f_s (it is f_s with widened
 //    M_p and front-averaged N_p); the π in F_scatter is kept as printed.
+//  - N^G_p is N_p averaged over incident azimuths across the half circle
+//    facing the light, read at φ (DualScatteringTables), not the printed
+//    constant (2/π)∫_{π/2}^{π} N_p applied at every φ: that one carries 2ā_f of
+//    energy over the circle and sends forward-scattered light back toward the
+//    light. Measured against the path tracer: DESIGN.md §8.
 //  - σ̄_b² in the tables is computed with the tables' d_b; the shader recomputes
 //    it for its own d_b when they differ (DualScatteringTables::withBackwardDensity).
 //

@@ -11,8 +11,14 @@
 //                what add along a path, and σ_f² = Σ β̄_f² in the global term)
 //   Ā_b          Eq. 10, Δ̄_b Eq. 11 (as printed)
 //   σ̄_b²         the square of Zinke's Eq. 12 as given in DESIGN.md §4, with d_b = options.d_b
-//   N^G_p        (2/π) ∫_{π/2}^{π} N_p(θ_d, φ') dφ' — a function of θ_d: its
-//                column holds N^G_p at θ_d = θ.
+//   N^G_p        (1/π) ∫_{φ−π/2}^{φ+π/2} N_p(θ_d, φ') dφ' — N_p averaged over
+//                incident azimuths spread across the half circle facing the
+//                light, read at the azimuth φ (DESIGN.md §5): a function of
+//                θ_d (the row's θ) and φ ∈ [0, π] (kNGPhiSamples, uniform).
+//                At φ = π it is Zinke's printed (2/π) ∫_{π/2}^{π} N_p dφ'
+//                (Eq. 18); unlike that constant it carries the lobe's own
+//                energy, ∫ N^G_p dφ = ∫ N_p dφ, and none of the forward
+//                lobes' energy back toward the light.
 //
 // Integration (documented, convergence tested in
 // tests/shading/dual_scattering_tables_test.cpp): the azimuthal integrals are
@@ -24,7 +30,7 @@
 // eccentricity ≠ 1 are averaged over the cross-section orientation φ_h
 // (uniform, 8 nodes), which is the same as averaging over φ_i. Measured
 // against order 96: order 8 is off by 3e-2, 16 by 1.5e-4, the default 24 by
-// 5e-5 (ā, Ā_b, N^G); a default build takes ~0.1 s on one core.
+// 5e-5 (ā, Ā_b, N^G); a default build takes ~0.3 s on one core.
 //
 // Numerical traps (DESIGN.md §4): Eqs. 10–12 are geometric series in ā_f²
 // that diverge as ā_f → 1 (σ_a → 0; the model's albedo even exceeds 1 near
@@ -51,7 +57,7 @@ namespace hairvox {
 struct TableBuildOptions {
     int thetaSamples = 181;  ///< uniform θ grid over [−π/2, π/2] (1° steps), [3, 10001]
     int quadratureOrder = 24; ///< Gauss–Legendre nodes per integration piece, [4, 256]
-    float d_b = 0.7f;        ///< backward density factor inside σ̄_b (Zinke Eq. 12), [0, 1]
+    float d_b = 1.0f;        ///< backward density factor inside σ̄_b (Zinke Eq. 12), [0, 1]
     bool threaded = true;    ///< TBB over θ rows (the result is the same either way)
 
     /// Throws InputError naming the first option outside its range.
@@ -72,8 +78,10 @@ public:
         Rgb ABar_b;                 ///< average backscattering attenuation (Eq. 10)
         Rgb DeltaBar_b;             ///< average backscattering shift (Eq. 11)
         Rgb sigma2Bar_b;            ///< average backscattering variance (Eq. 12 squared)
-        Rgb NG_R, NG_TT, NG_TRT;    ///< front-averaged N_p at θ_d = θ (Eq. 18)
     };
+
+    /// N^G is tabulated at φ = π·j/(kNGPhiSamples − 1): 5° steps.
+    static constexpr int kNGPhiSamples = 37;
 
     /// Integrates the tables for `params` (validated). ~0.1–0.5 s.
     static DualScatteringTables build(const FiberParams& params,
@@ -108,14 +116,21 @@ public:
     }
     Rgb aBar_f(float theta) const { return interpolate(theta, &Sample::aBar_f); }
     Rgb beta2Bar_f(float theta) const { return interpolate(theta, &Sample::beta2Bar_f); }
-    /// N^G_R, N^G_TT, N^G_TRT at θ_d.
-    LobeValues NG(float theta_d) const;
+    /// N^G_R, N^G_TT, N^G_TRT at θ_d and the azimuth φ (any angle: N^G is
+    /// even and 2π-periodic in φ), bilinearly interpolated.
+    LobeValues NG(float theta_d, float phi) const;
+    /// The tabulated N^G at row k (θ_d = theta(k)) and φ = π·j/(kNGPhiSamples − 1).
+    const LobeValues& NGSample(int k, int j) const {
+        return ng_[static_cast<std::size_t>(k) * kNGPhiSamples + static_cast<std::size_t>(j)];
+    }
 
     /// The same tables with σ̄_b² recomputed for another d_b (the only entry that depends on it).
     DualScatteringTables withBackwardDensity(float d_b) const;
 
     /// One row per θ sample: `theta` (radians), then each quantity per channel
-    /// (af_r,af_g,af_b,ab_r,...). Written atomically.
+    /// (af_r,af_g,af_b,ab_r,...), then N^G at θ_d = θ per lobe, azimuth and
+    /// channel (NGR_phi000_r, ... NGTRT_phi180_b; φ in degrees). Written
+    /// atomically.
     void writeCsv(const std::filesystem::path& path) const;
 
     int size() const { return static_cast<int>(rows_.size()); }
@@ -150,6 +165,7 @@ private:
     FiberParams params_;
     TableBuildOptions options_;
     std::vector<Sample> rows_;
+    std::vector<LobeValues> ng_; ///< [row][φ sample]
     float invStep_ = 0, lastIndex_ = 0;
     std::uint64_t cacheKey_ = 0;
     bool loadedFromCache_ = false;

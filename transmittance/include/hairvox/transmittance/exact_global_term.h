@@ -4,9 +4,9 @@
 // ray-facing ribbons of width k·D, so a ray crossing a fiber of tangent u
 // registers one hit with probability proportional to k·D·|ω × u| — the
 // cross-section the grid modes integrate — and each hit is one hair. This is
-// the medium the grid (λ scaled by k) and the rasterizer (coverage
-// 1 − (1 − α)^k) see; counting each hit of a D-wide ribbon k times instead
-// would stack the k hairs on one spot and leave V unchanged by k. Every
+// the medium the grid (λ scaled by k), the rasterizer and the path tracer
+// (the same ribbons) see; counting each hit of a D-wide ribbon k times
+// instead would stack the k hairs on one spot and leave V unchanged by k. Every
 // crossing along a shadow ray is collected. For one ray crossing fibers j = 1..m:
 //   V = [m = 0],  P = ∏ ā_f(θ_j),  σ_f² = Σ β̄_f²(θ_j),  T_s = d_f (P − V).
 // With K rays whose origins are spread over a disk of radius r perpendicular
