@@ -1,7 +1,9 @@
 // hairvox bench [--scene FILE ...] [--out DIR] [--quick] [--threads N] [--runs N] [--no-scaling]
+//               [--no-accuracy] [--no-model]
 // Sweeps global-term mode × voxel size × shading rate against exact-mode
-// references, then time and memory against segment count and image size
-// (bench/sweep); writes results.csv, results.md and PNG plots.
+// references, dual scattering against the path tracer (the model sweep), then
+// time and memory against segment count and image size (bench/sweep); writes
+// results.csv, results.md and PNG plots.
 // `hairvox bench --one JOB.json` is the worker that runs one job of a sweep in
 // its own process (so that its peak memory is its own).
 #include "../commands.h"
@@ -27,6 +29,8 @@ struct BenchOptions {
     int threads = 0;
     std::optional<int> runs;
     bool noScaling = false;
+    bool noModel = false;
+    bool noAccuracy = false;
     std::string job;
 };
 
@@ -44,6 +48,10 @@ std::string commandLine(const BenchOptions& opt) {
         line += " --runs " + std::to_string(*opt.runs);
     if (opt.noScaling)
         line += " --no-scaling";
+    if (opt.noModel)
+        line += " --no-model";
+    if (opt.noAccuracy)
+        line += " --no-accuracy";
     return line;
 }
 
@@ -53,16 +61,26 @@ void runBench(const BenchOptions& opt) {
         return;
     }
     SweepOptions sweep =
-        opt.quick ? SweepOptions::quick() : SweepOptions::full("data/scenes/ratboy_mohawk.json");
+        opt.quick ? SweepOptions::quick("data/scenes") : SweepOptions::full("data/scenes");
     if (!opt.scenes.empty()) {
+        // The model sweep path traces the given scenes at its own width.
+        const std::uint32_t modelWidth =
+            sweep.model.scenes.empty() ? 256 : sweep.model.scenes.front().width;
         sweep.scenes.clear();
+        sweep.model.scenes.clear();
         for (const std::string& file : opt.scenes) {
             BenchScene scene;
             scene.file = std::filesystem::absolute(file);
             scene.label = scene.file.stem().string();
             sweep.scenes.push_back(scene);
+            if (std::filesystem::exists(scene.file))
+                sweep.model.scenes.push_back(scene.atWidth(modelWidth));
         }
     }
+    if (opt.noModel)
+        sweep.model.scenes.clear();
+    if (opt.noAccuracy)
+        sweep.scenes.clear();
     if (opt.noScaling) {
         sweep.segmentScaling.clear();
         sweep.pixelScaling.clear();
@@ -98,6 +116,10 @@ void addBenchCommand(CLI::App& app) {
     cmd->add_option("--runs", opt->runs, "Timed renders per configuration (default 3; --quick: 1)")
         ->check(CLI::Range(1, 100));
     cmd->add_flag("--no-scaling", opt->noScaling, "Skip the scaling sweep");
+    cmd->add_flag("--no-accuracy", opt->noAccuracy,
+                  "Skip the accuracy sweep (modes and voxel sizes against exact mode)");
+    cmd->add_flag("--no-model", opt->noModel,
+                  "Skip the model sweep (dual scattering against the path tracer)");
     cmd->add_option("--one", opt->job, "Run one job of a sweep (internal)")->group("");
     cmd->callback([opt] { runBench(*opt); });
 }

@@ -1,9 +1,9 @@
 // hairvox compare ESTIMATE.exr REFERENCE.exr [--what hair|beauty] [--mask LAYER]
-// [--block N]:
+// [--block N] [--figure OUT.png]:
 // how far one render is from another (film/image_compare.h) over the
 // reference's masked pixels (by default the hair) — relative L1, RMSE and
 // bias, and, against a path-traced reference, its noise floor and the errors
-// with its noise removed.
+// with its noise removed. --figure draws estimate | reference | difference.
 #include "../commands.h"
 
 #include <hairvox/core/error.h>
@@ -11,6 +11,10 @@
 #include <hairvox/film/image_file.h>
 #include <hairvox/pipeline/pipeline.h>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <memory>
 #include <stdexcept>
@@ -27,11 +31,63 @@ struct CompareOptions {
     std::vector<std::string> layers;
     std::string mask = "hair.A";
     int block = 1;
+    std::string figure;
+    float exposure = 0;
 };
 
+/// Blue (estimate darker) – white – red (brighter), saturating at |d| = 1.
+std::array<std::uint8_t, 3> diverging(double d) {
+    const double t = std::clamp(std::abs(d), 0.0, 1.0);
+    const auto c = [](double v) {
+        return static_cast<std::uint8_t>(std::lround(255.0 * v));
+    };
+    const std::uint8_t fade = c(1.0 - t);
+    return d >= 0 ? std::array<std::uint8_t, 3>{255, fade, fade}
+                  : std::array<std::uint8_t, 3>{fade, fade, 255};
+}
+
+/// The figure: the two beauties tone-mapped alike, then the signed difference
+/// of the compared values (per block when --block > 1), full colour at ±50% of
+/// the reference's mean over its masked pixels; 4 white pixels between panels.
+void writeFigure(const CompareOptions& opt, const Film& estimateFilm, const Film& referenceFilm,
+                 const ComparedImage& estimate, const ComparedImage& reference) {
+    const int w = referenceFilm.width(), h = referenceFilm.height(), gap = 4;
+    const int fw = 3 * w + 2 * gap;
+    std::vector<std::uint8_t> rgb(std::size_t(fw) * std::size_t(h) * 3, 255);
+    const auto put = [&](int panel, const std::vector<std::uint8_t>& pixels) {
+        for (int y = 0; y < h; ++y)
+            std::copy_n(pixels.begin() + std::ptrdiff_t(y) * w * 3, w * 3,
+                        rgb.begin() + (std::ptrdiff_t(y) * fw + panel * (w + gap)) * 3);
+    };
+    put(0, previewPixels(estimateFilm, opt.exposure, ToneMap::Filmic));
+    put(1, previewPixels(referenceFilm, opt.exposure, ToneMap::Filmic));
+    double sum = 0, weight = 0;
+    for (std::size_t p = 0; p < reference.value.size(); ++p)
+        if (reference.mask[p] > 0) {
+            sum += double(reference.value[p].average());
+            weight += 1;
+        }
+    const double scale = weight > 0 && sum > 0 ? 0.5 * sum / weight : 1.0;
+    std::vector<std::uint8_t> diff(std::size_t(w) * std::size_t(h) * 3, 255);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const std::size_t b = std::size_t(y / opt.block) * std::size_t(reference.width) +
+                                  std::size_t(x / opt.block);
+            if (!(reference.mask[b] > 0))
+                continue;
+            const auto c =
+                diverging(double((estimate.value[b] - reference.value[b]).average()) / scale);
+            std::copy(c.begin(), c.end(), diff.begin() + (std::ptrdiff_t(y) * w + x) * 3);
+        }
+    put(2, diff);
+    writePng(opt.figure, fw, h, rgb);
+}
+
 void runCompare(const CompareOptions& opt) {
+    const Film estimateFilm = filmFromExr(readExr(opt.estimate)),
+               referenceFilm = filmFromExr(readExr(opt.reference));
     const auto load = [&](const std::string& path) {
-        const Film film = filmFromExr(readExr(path));
+        const Film& film = path == opt.estimate ? estimateFilm : referenceFilm;
         try {
             if (!opt.layers.empty())
                 return ComparedImage::fromFilm(film, opt.layers, opt.mask);
@@ -69,9 +125,14 @@ void runCompare(const CompareOptions& opt) {
     std::printf("relative bias:   %+.4f\n", e->relBias);
     if (!reference.halfA.empty()) {
         std::printf("reference noise: relative L1 floor %.4f\n", e->noiseFloorL1);
-        std::printf("noise removed:   relative L1 %.4f, relative RMSE %.4f%s\n", e->relL1NoiseRemoved,
-                    e->relRmseNoiseRemoved,
-                    e->resolved() ? "" : " (not resolved: within 1.5x the reference's noise floor)");
+        std::printf("noise removed:   relative L1 %.4f, relative RMSE %.4f%s\n",
+                    e->relL1NoiseRemoved, e->relRmseNoiseRemoved,
+                    e->resolved() ? ""
+                                  : " (not resolved: within 1.5x the reference's noise floor)");
+    }
+    if (!opt.figure.empty()) {
+        writeFigure(opt, estimateFilm, referenceFilm, estimate, reference);
+        std::printf("wrote %s\n", opt.figure.c_str());
     }
 }
 
@@ -88,9 +149,10 @@ void addCompareCommand(CLI::App& app) {
                     "hair: the hair's radiance (direct + multiple scattering); beauty: the image")
         ->capture_default_str()
         ->check(CLI::IsMember({"hair", "beauty"}));
-    cmd->add_option("--layers", opt->layers,
-                    "Compare the sum of these RGB layers instead (e.g. direct_R,direct_TT,direct_TRT; "
-                    "no noise estimate)")
+    cmd->add_option(
+           "--layers", opt->layers,
+           "Compare the sum of these RGB layers instead (e.g. direct_R,direct_TT,direct_TRT; "
+           "no noise estimate)")
         ->delimiter(',');
     cmd->add_option("--mask", opt->mask, "Scalar channel selecting the compared pixels (> 0)")
         ->capture_default_str();
@@ -99,6 +161,13 @@ void addCompareCommand(CLI::App& app) {
                     "a bias does not")
         ->capture_default_str()
         ->check(CLI::Range(1, 4096));
+    cmd->add_option("--figure", opt->figure,
+                    "Write a PNG: estimate | reference (filmic) | signed difference of the "
+                    "compared values (red: estimate brighter, blue: darker, full colour at ±50% "
+                    "of the reference's mean)");
+    cmd->add_option("--exposure", opt->exposure, "Stops applied to the figure's two renders")
+        ->capture_default_str()
+        ->check(CLI::Range(-20.0f, 20.0f));
     cmd->callback([opt] { runCompare(*opt); });
 }
 

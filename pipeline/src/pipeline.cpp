@@ -12,8 +12,8 @@
 #include <hairvox/transmittance/exact_global_term.h>
 
 #include <chrono>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <sstream>
 
 namespace hairvox {
@@ -99,6 +99,7 @@ std::unique_ptr<SceneAssets> loadSceneAssets(const Scene& scene, const PipelineO
         ExactOptions exact;
         exact.rays = static_cast<int>(scene.exact.rays);
         exact.radius = scene.exact.radius;
+        exact.seed = scene.exact.seed;
         assets->globalTerm = makeExactModel(assets->groom, crossings, settings, exact);
         break;
     }
@@ -186,8 +187,7 @@ SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& opti
     return result;
 }
 
-SceneRender renderPathTraced(const Scene& scene, const PipelineOptions& options,
-                             bool writeFiles) {
+SceneRender renderPathTraced(const Scene& scene, const PipelineOptions& options, bool writeFiles) {
     SceneRender result;
     auto start = Clock::now();
     std::string groomWarnings;
@@ -211,9 +211,9 @@ SceneRender renderPathTraced(const Scene& scene, const PipelineOptions& options,
         if (attribute("hairvox:integrator") != toString(Integrator::Path))
             throw InputError(strCat(file, ": not a path-traced image; cannot continue it"));
         if (attribute("hairvox:pathTraceHash") != hash)
-            throw InputError(strCat(file, ": rendered from another scene, groom or seed (render hash ",
-                                    attribute("hairvox:pathTraceHash"), ", this scene's ", hash,
-                                    "); not continued"));
+            throw InputError(strCat(
+                file, ": rendered from another scene, groom or seed (render hash ",
+                attribute("hairvox:pathTraceHash"), ", this scene's ", hash, "); not continued"));
         const std::string spp = attribute("hairvox:spp");
         char* end = nullptr;
         const unsigned long n = std::strtoul(spp.c_str(), &end, 10);
@@ -295,9 +295,13 @@ std::string pathTraceHash(const Scene& scene, const Groom& groom) {
     h.value(c.position).value(c.lookAt).value(c.up).value(c.fovY).value(c.width).value(c.height);
     h.value(scene.head.has_value());
     if (scene.head)
-        h.value(scene.head->sphere.center).value(scene.head->sphere.radius).value(scene.head->albedo);
+        h.value(scene.head->sphere.center)
+            .value(scene.head->sphere.radius)
+            .value(scene.head->albedo);
     h.value(scene.background);
-    h.value(scene.pathTrace.seed).value(scene.pathTrace.maxDepth).value(scene.pathTrace.rouletteDepth);
+    h.value(scene.pathTrace.seed)
+        .value(scene.pathTrace.maxDepth)
+        .value(scene.pathTrace.rouletteDepth);
     return hexDigest(h.digest());
 }
 
@@ -349,16 +353,15 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
     if (r.pathTrace) {
         const PathTraceStats& pt = *r.pathTrace;
         row("load", r.times.load, "the groom");
-        std::snprintf(line, sizeof(line),
-                      "%u spp (%u this run%s); %s paths, %s rays + %s shadow rays: %.2f M rays/s, "
-                      "%.3f M paths/s; %.1f scattering events per path, deepest %u",
-                      pt.spp, pt.sppThisRun,
-                      pt.interrupted ? ", interrupted" : (pt.timeLimited ? ", time limit" : ""),
-                      thousands(pt.paths).c_str(), thousands(pt.rays).c_str(),
-                      thousands(pt.shadowRays).c_str(), 1e-6 * pt.raysPerSecond(),
-                      1e-6 * pt.pathsPerSecond(),
-                      pt.paths > 0 ? double(pt.scatteringEvents) / double(pt.paths) : 0.0,
-                      pt.deepestPath);
+        std::snprintf(
+            line, sizeof(line),
+            "%u spp (%u this run%s); %s paths, %s rays + %s shadow rays: %.2f M rays/s, "
+            "%.3f M paths/s; %.1f scattering events per path, deepest %u",
+            pt.spp, pt.sppThisRun,
+            pt.interrupted ? ", interrupted" : (pt.timeLimited ? ", time limit" : ""),
+            thousands(pt.paths).c_str(), thousands(pt.rays).c_str(),
+            thousands(pt.shadowRays).c_str(), 1e-6 * pt.raysPerSecond(), 1e-6 * pt.pathsPerSecond(),
+            pt.paths > 0 ? double(pt.scatteringEvents) / double(pt.paths) : 0.0, pt.deepestPath);
         row("trace", r.times.trace, line);
         std::snprintf(line, sizeof(line), "%s paths stopped at the depth cap %u (throughput %.2g)",
                       thousands(pt.pathsAtDepthCap).c_str(), scene.pathTrace.maxDepth,

@@ -380,6 +380,8 @@ Scene parseScene(const nlohmann::json& document, const std::string& sourceName,
                 scene.exact.rays = static_cast<std::uint32_t>(r.integer(1, kMaxExactRays));
             if (const JsonValue r = exact["radius"]; r.present())
                 scene.exact.radius = r.numberF(kExactRadius);
+            if (const JsonValue r = exact["seed"]; r.present())
+                scene.exact.seed = r.integer(0, std::numeric_limits<std::uint64_t>::max());
             exact.finish();
         }
         gt.finish();
@@ -389,8 +391,8 @@ Scene parseScene(const nlohmann::json& document, const std::string& sourceName,
             scene.integrator = v.oneOf(kIntegratorNames);
         } else {
             JsonObject in = v.object();
-            scene.integrator = in.required("type", "\"dual_scattering\" or \"path\"")
-                                   .oneOf(kIntegratorNames);
+            scene.integrator =
+                in.required("type", "\"dual_scattering\" or \"path\"").oneOf(kIntegratorNames);
             PathTraceSettings& pt = scene.pathTrace;
             const auto set = [&](std::string_view key, auto assign) {
                 const JsonValue x = in[key];
@@ -401,7 +403,9 @@ Scene parseScene(const nlohmann::json& document, const std::string& sourceName,
                 assign(x);
                 checkAt(x, [&] { pt.validate(); });
             };
-            set("spp", [&](const JsonValue& x) { pt.spp = static_cast<std::uint32_t>(x.integer(1, 1'000'000)); });
+            set("spp", [&](const JsonValue& x) {
+                pt.spp = static_cast<std::uint32_t>(x.integer(1, 1'000'000));
+            });
             set("time_limit", [&](const JsonValue& x) { pt.timeLimit = x.number(kTimeLimit); });
             set("max_depth", [&](const JsonValue& x) {
                 pt.maxDepth = static_cast<std::uint32_t>(x.integer(1, 100'000));

@@ -12,7 +12,6 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
-#include <sstream>
 
 namespace hairvox {
 namespace {
@@ -79,13 +78,20 @@ std::vector<std::vector<std::string>> readCsv(const std::filesystem::path& path)
     std::vector<std::vector<std::string>> rows;
     std::string line;
     while (std::getline(in, line)) {
-        std::vector<std::string> cells;
-        std::stringstream ss(line);
-        std::string cell;
-        while (std::getline(ss, cell, ','))
-            cells.push_back(cell);
-        if (!line.empty() && line.back() == ',')
-            cells.emplace_back();
+        // RFC 4180 cells: a quoted cell may hold commas and doubled quotes.
+        std::vector<std::string> cells(1);
+        bool quoted = false;
+        for (std::size_t i = 0; i < line.size(); ++i) {
+            const char c = line[i];
+            if (quoted && c == '"' && i + 1 < line.size() && line[i + 1] == '"')
+                cells.back() += line[++i];
+            else if (c == '"')
+                quoted = !quoted;
+            else if (c == ',' && !quoted)
+                cells.emplace_back();
+            else
+                cells.back() += c;
+        }
         rows.push_back(cells);
     }
     return rows;
@@ -135,13 +141,19 @@ TEST(BenchSweep, TinySweepWritesTablesAndPlots) {
         s.width = s.height = size;
         o.pixelScaling.push_back(s);
     }
+    o.model.scenes = {sceneFile("tiny", scene).atWidth(32)};
+    o.model.melanins = {{"blond", 0.3f}, {"dark", 3.0f}};
+    o.model.modes = {GlobalTermMode::Exact, GlobalTermMode::Grid};
+    o.model.spp = 8;
+    o.model.block = 4;
     o.outDir = dir / "out";
     const SweepResult result = runSweep(o);
 
-    // 1 reference + 2 rates × (1 exact + 2 grid + 2 approx) + 2 + 2 scaling rows.
-    ASSERT_EQ(result.rows.size(), 15u);
+    // 1 reference + 2 rates × (1 exact + 2 grid + 2 approx) + 2 melanins × (1
+    // path reference + 2 modes) + 2 + 2 scaling rows.
+    ASSERT_EQ(result.rows.size(), 21u);
     const auto csv = readCsv(o.outDir / "results.csv");
-    ASSERT_EQ(csv.size(), 16u);
+    ASSERT_EQ(csv.size(), 22u);
     ASSERT_EQ(csv[0].size(), kBenchCsvColumns.size());
     for (std::size_t i = 0; i < kBenchCsvColumns.size(); ++i)
         EXPECT_EQ(csv[0][i], kBenchCsvColumns[i]);
@@ -150,11 +162,29 @@ TEST(BenchSweep, TinySweepWritesTablesAndPlots) {
         EXPECT_GT(std::stod(csv[r][column("total_s")]), 0.0) << r;
         EXPECT_EQ(csv[r][column("peak_mib")], "") << "in-process jobs report no peak memory";
         const bool accuracy = csv[r][column("sweep")] == "accuracy";
-        EXPECT_EQ(!csv[r][column("rel_l1")].empty(), accuracy) << r;
+        const bool model = csv[r][column("sweep")] == "model";
+        const bool pathReference = csv[r][column("sweep")] == "path_reference";
+        EXPECT_EQ(!csv[r][column("rel_l1")].empty(), accuracy || model) << r;
         EXPECT_EQ(!csv[r][column("mae_v")].empty(), accuracy) << r;
+        EXPECT_EQ(!csv[r][column("eumelanin")].empty(), model || pathReference) << r;
+        EXPECT_EQ(!csv[r][column("spp")].empty(), pathReference) << r;
         if (accuracy) {
             EXPECT_GE(std::stod(csv[r][column("rel_l1")]), 0.0);
             EXPECT_LT(std::stod(csv[r][column("rel_l1")]), 1.0);
+            // The exact reference's two halves (1 ray each over the h0 disk) give its floor.
+            EXPECT_GT(std::stod(csv[r][column("noise_floor_l1")]), 0.0) << r;
+        }
+        if (model) {
+            // Against a noisy 8-spp reference: the floor is known and positive.
+            EXPECT_GT(std::stod(csv[r][column("noise_floor_l1")]), 0.0) << r;
+            EXPECT_LE(std::stod(csv[r][column("rel_l1_noise_removed")]),
+                      std::stod(csv[r][column("rel_l1")]))
+                << r;
+        }
+        if (pathReference) {
+            EXPECT_EQ(csv[r][column("spp")], "8") << r;
+            EXPECT_GT(std::stod(csv[r][column("rays_per_s")]), 0.0) << r;
+            EXPECT_GT(std::stod(csv[r][column("paths_per_s")]), 0.0) << r;
         }
     }
     EXPECT_EQ(csv[1][column("sweep")], "reference");
@@ -173,7 +203,8 @@ TEST(BenchSweep, TinySweepWritesTablesAndPlots) {
     for (const char* needle :
          {"## Summary", "| tiny | 3,300 | 64×64 |", "## tiny", "| exact K=2 (reference) |",
           "| grid x1 | 0.012 | vertex |", "## Scaling with segment count",
-          "## Scaling with image size", "cost ∝ pixels^k: total time k = "})
+          "## Scaling with image size", "cost ∝ pixels^k: total time k = ",
+          "## Model error: dual scattering against path tracing", "| tiny, dark | grid | "})
         EXPECT_NE(text.find(needle), std::string::npos) << needle << "\n" << text;
 
     // matplotlib figures (bench/sweep/plot_sweep.py): 11 × 6.5 in and 2 × 7 × 5.2 in at 120 dpi.
@@ -186,8 +217,9 @@ TEST(BenchSweep, CommandRunsEachJobInItsOwnProcess) {
     test::TempDir dir;
     const auto scene = writeTinyScene(dir);
     const auto out = dir / "out";
-    const test::CommandResult r = test::runHairvox(
-        "bench --quick --no-scaling --scene '" + scene.string() + "' --out '" + out.string() + "'");
+    const test::CommandResult r =
+        test::runHairvox("bench --quick --no-scaling --no-model --scene '" + scene.string() +
+                         "' --out '" + out.string() + "'");
     ASSERT_EQ(r.exitCode, 0) << r.output;
     EXPECT_NE(r.output.find("wrote " + (out / "results.md").string()), std::string::npos)
         << r.output;
@@ -198,10 +230,14 @@ TEST(BenchSweep, CommandRunsEachJobInItsOwnProcess) {
 }
 
 TEST(BenchSweep, BadInputIsAnInputError) {
-    SweepOptions o = SweepOptions::quick();
+    SweepOptions o = SweepOptions::quick(HAIRVOX_DATA_DIR "/scenes");
     o.runs = 0;
     EXPECT_THROW(o.validate(), InputError);
-    o = SweepOptions::full("no/such/scene.json");
+    o = SweepOptions::full("no/such/dir");
+    EXPECT_THROW(o.validate(), InputError);
+    o = SweepOptions::quick(HAIRVOX_DATA_DIR "/scenes");
+    o.validate();
+    o.model.block = 0;
     EXPECT_THROW(o.validate(), InputError);
     BenchScene s = sceneFile("x", "some.json");
     s.style = GroomStyle::Curly;

@@ -77,7 +77,8 @@ json sceneToJson(const BenchScene& s) {
             {"strands", s.strands},
             {"points_per_strand", s.pointsPerStrand},
             {"width", s.width},
-            {"height", s.height}};
+            {"height", s.height},
+            {"eumelanin", s.eumelanin ? json(*s.eumelanin) : json(nullptr)}};
 }
 
 BenchScene sceneFromJson(const json& j) {
@@ -90,6 +91,8 @@ BenchScene sceneFromJson(const json& j) {
     s.pointsPerStrand = j.at("points_per_strand").get<std::uint32_t>();
     s.width = j.at("width").get<std::uint32_t>();
     s.height = j.at("height").get<std::uint32_t>();
+    if (!j.at("eumelanin").is_null())
+        s.eumelanin = j.at("eumelanin").get<float>();
     return s;
 }
 
@@ -171,6 +174,10 @@ json jobToJson(const BenchJob& job) {
     for (const auto& p : job.probeFiles)
         probeFiles.push_back(p.string());
     return {{"reference", job.reference},
+            {"path_reference", job.pathReference},
+            {"spp", job.spp},
+            {"time_limit", job.timeLimit},
+            {"block", job.block},
             {"scene", sceneToJson(job.scene)},
             {"mode", toString(job.config.mode)},
             {"voxel_scale", job.config.voxelScale},
@@ -194,6 +201,10 @@ json jobToJson(const BenchJob& job) {
 BenchJob jobFromJson(const json& j) {
     BenchJob job;
     job.reference = j.at("reference").get<bool>();
+    job.pathReference = j.at("path_reference").get<bool>();
+    job.spp = j.at("spp").get<std::uint32_t>();
+    job.timeLimit = j.at("time_limit").get<double>();
+    job.block = j.at("block").get<int>();
     job.scene = sceneFromJson(j.at("scene"));
     job.config.mode = kGlobalTermModeNames.parse(j.at("mode").get<std::string>()).value();
     job.config.voxelScale = j.at("voxel_scale").get<double>();
@@ -226,6 +237,7 @@ json measurementToJson(const BenchMeasurement& m) {
                 {"global_term", t.globalTerm},
                 {"raster", t.raster},
                 {"shade", t.shade},
+                {"trace", t.trace},
                 {"write", t.write}}},
               {"total", m.totalSeconds},
               {"runs", m.runs},
@@ -236,7 +248,20 @@ json measurementToJson(const BenchMeasurement& m) {
               {"voxel_size", m.voxelSize},
               {"default_voxel_size", m.defaultVoxelSize},
               {"image", nullptr},
-              {"probe", nullptr}};
+              {"probe", nullptr},
+              {"path_trace", nullptr}};
+    if (m.pathTrace) {
+        const PathTraceStats& s = *m.pathTrace;
+        j["path_trace"] = {{"spp", s.spp},
+                           {"seconds", s.seconds},
+                           {"paths", s.paths},
+                           {"rays", s.rays},
+                           {"shadow_rays", s.shadowRays},
+                           {"deepest_path", s.deepestPath},
+                           {"paths_at_depth_cap", s.pathsAtDepthCap},
+                           {"energy_at_depth_cap", s.energyAtDepthCap},
+                           {"time_limited", s.timeLimited}};
+    }
     if (m.image)
         j["image"] = {{"rel_l1", m.image->relL1},
                       {"rel_rmse", m.image->relRmse},
@@ -262,6 +287,7 @@ BenchMeasurement measurementFromJson(const json& j) {
     m.times.globalTerm = t.at("global_term").get<double>();
     m.times.raster = t.at("raster").get<double>();
     m.times.shade = t.at("shade").get<double>();
+    m.times.trace = t.at("trace").get<double>();
     m.times.write = t.at("write").get<double>();
     m.totalSeconds = j.at("total").get<double>();
     m.runs = j.at("runs").get<int>();
@@ -271,8 +297,7 @@ BenchMeasurement measurementFromJson(const json& j) {
     m.activeVoxels = j.at("active_voxels").get<std::uint64_t>();
     m.voxelSize = j.at("voxel_size").get<double>();
     m.defaultVoxelSize = j.at("default_voxel_size").get<double>();
-    if (const json& i = j.at("image"); !i.is_null())
-    {
+    if (const json& i = j.at("image"); !i.is_null()) {
         ImageError e;
         e.relL1 = i.at("rel_l1").get<double>();
         e.relRmse = i.at("rel_rmse").get<double>();
@@ -286,6 +311,19 @@ BenchMeasurement measurementFromJson(const json& j) {
     if (const json& p = j.at("probe"); !p.is_null())
         m.probe = ProbeError{p.at("mae_v").get<double>(), p.at("mae_ts").get<double>(),
                              p.at("bias_n").get<double>(), p.at("mean_n_ref").get<double>()};
+    if (const json& p = j.at("path_trace"); !p.is_null()) {
+        PathTraceStats s;
+        s.spp = p.at("spp").get<std::uint32_t>();
+        s.seconds = p.at("seconds").get<double>();
+        s.paths = p.at("paths").get<std::uint64_t>();
+        s.rays = p.at("rays").get<std::uint64_t>();
+        s.shadowRays = p.at("shadow_rays").get<std::uint64_t>();
+        s.deepestPath = p.at("deepest_path").get<std::uint32_t>();
+        s.pathsAtDepthCap = p.at("paths_at_depth_cap").get<std::uint64_t>();
+        s.energyAtDepthCap = p.at("energy_at_depth_cap").get<double>();
+        s.timeLimited = p.at("time_limited").get<bool>();
+        m.pathTrace = s;
+    }
     return m;
 }
 

@@ -22,6 +22,14 @@ namespace hairvox::bench {
 
 struct BenchJob {
     bool reference = false; ///< render the exact reference and write the probe references
+    /// Path trace the model sweep's reference (spp, timeLimit) and write its
+    /// hair radiance to referenceImage.
+    bool pathReference = false;
+    std::uint32_t spp = 0;
+    double timeLimit = 0;
+    /// > 0: the model sweep — compare the hair's radiance with the path-traced
+    /// reference as means over block × block pixels.
+    int block = 0;
     BenchScene scene;
     BenchConfig config;
     double voxelSize = 0; ///< grid voxel size or exact footprint radius; 0: h0

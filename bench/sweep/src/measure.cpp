@@ -73,7 +73,7 @@ ProbeError meanProbeError(const std::vector<std::vector<GlobalTerm>>& estimate,
 /// run is longer than singleRunAbove) and takes medians.
 BenchMeasurement timeRenders(const Scene& scene, const BenchJob& job,
                              const PipelineOptions& options, Film* lastFilm) {
-    std::vector<double> load, voxelize, tables, globalTerm, raster, shade, write, total;
+    std::vector<double> load, voxelize, tables, globalTerm, raster, shade, trace, write, total;
     BenchMeasurement m;
     int runs = job.runs;
     for (int r = 0; r < runs; ++r) {
@@ -85,11 +85,13 @@ BenchMeasurement timeRenders(const Scene& scene, const BenchJob& job,
         globalTerm.push_back(t.globalTerm);
         raster.push_back(t.raster);
         shade.push_back(t.shade);
+        trace.push_back(t.trace);
         write.push_back(t.write);
         total.push_back(t.total());
         m.segments = render.raster ? render.raster->segments : 0;
         m.shadingPoints = render.raster ? render.raster->shadingPoints : 0;
         m.activeVoxels = render.activeVoxels;
+        m.pathTrace = render.pathTrace;
         m.voxelSize = scene.globalTermMode == GlobalTermMode::Exact ? double(scene.exact.radius)
                                                                     : render.voxelSize;
         if (r == 0 && job.singleRunAbove > 0 && t.total() > job.singleRunAbove)
@@ -98,8 +100,14 @@ BenchMeasurement timeRenders(const Scene& scene, const BenchJob& job,
         if (r + 1 == runs && lastFilm)
             *lastFilm = std::move(render.film);
     }
-    m.times = {median(load),   median(voxelize), median(tables), median(globalTerm),
-               median(raster), median(shade),    median(write)};
+    m.times.load = median(load);
+    m.times.voxelize = median(voxelize);
+    m.times.tables = median(tables);
+    m.times.globalTerm = median(globalTerm);
+    m.times.raster = median(raster);
+    m.times.shade = median(shade);
+    m.times.trace = median(trace);
+    m.times.write = median(write);
     m.totalSeconds = median(total);
     m.runs = runs;
     if (job.isolated)
@@ -124,18 +132,43 @@ BenchMeasurement runJob(const BenchJob& job) {
         // the probe references so that its peak memory is its own.
         double h0 = 0;
         const std::vector<GlobalTermQuery> points = probePointsOf(scene, job, &h0);
-        scene.exact.rays = job.config.rays;
+        // Two independent halves of K/2 rays each (seeds 1 and 2): their mean
+        // is the reference, half A's difference from it its noise, removed
+        // from every error against it (film/image_compare.h).
         scene.exact.radius = static_cast<float>(h0);
+        scene.exact.rays = std::max<std::uint32_t>(1, job.config.rays / 2);
         Film film;
         BenchMeasurement m = timeRenders(scene, job, options, &film);
+        ComparedImage reference = ComparedImage::beautyOf(film, kHairAlphaLayer);
+        scene.exact.seed = 2;
+        const BenchMeasurement b = timeRenders(scene, job, options, &film);
+        const ComparedImage halfB = ComparedImage::beautyOf(film, kHairAlphaLayer);
+        film = Film();
+        reference.halfA = reference.value;
+        for (std::size_t p = 0; p < reference.value.size(); ++p)
+            reference.value[p] = 0.5f * (reference.halfA[p] + halfB.value[p]);
+        m.times += b.times;
+        m.totalSeconds += b.totalSeconds;
+        m.peakMiB = b.peakMiB;
         m.defaultVoxelSize = h0;
-        writeComparedImage(job.referenceImage, ComparedImage::beautyOf(film, kHairAlphaLayer));
+        writeComparedImage(job.referenceImage, reference);
         for (std::size_t i = 0; i < job.probeScales.size() && job.probePoints > 0; ++i) {
             Scene probe = scene;
             probe.exact.rays = job.probeRays;
             probe.exact.radius = static_cast<float>(job.probeScales[i] * h0);
             writeProbeTerms(job.probeFiles.at(i), probeTerms(probe, options, points));
         }
+        return m;
+    }
+
+    if (job.pathReference) {
+        scene.integrator = Integrator::Path;
+        scene.pathTrace.spp = job.spp;
+        scene.pathTrace.timeLimit = job.timeLimit;
+        scene.validate();
+        Film film;
+        BenchMeasurement m = timeRenders(scene, job, options, &film);
+        writeComparedImage(job.referenceImage, hairRadianceOf(film));
         return m;
     }
 
@@ -149,7 +182,10 @@ BenchMeasurement runJob(const BenchJob& job) {
     Film film;
     BenchMeasurement m = timeRenders(scene, job, options, &film);
     m.defaultVoxelSize = m.voxelSize / job.config.voxelScale;
-    if (!job.referenceImage.empty())
+    if (job.block > 0)
+        m.image = compareImages(hairRadianceOf(film).boxFiltered(job.block),
+                                readComparedImage(job.referenceImage).boxFiltered(job.block));
+    else if (!job.referenceImage.empty())
         m.image = compareImages(ComparedImage::beautyOf(film, kHairAlphaLayer),
                                 readComparedImage(job.referenceImage));
     film = Film();

@@ -3,6 +3,8 @@
 // (median of the runs), and its errors against the scene's references:
 //  - image: relative L1 and RMSE of the beauty over hair pixels against the
 //    exact reference (film/image_compare.h);
+//  - model: the hair's radiance against a path-traced reference, as means
+//    over blocks (the model sweep; sweep.h);
 //  - probe: MAE of V and T_s (transmittance/probe.h) at points on the fibers
 //    toward every lit light, against exact mode with many rays over a disk of
 //    the configuration's voxel size. The head is left out of the probe: points

@@ -88,6 +88,45 @@ std::string fitText(const char* what, const std::optional<PowerLawFit>& f) {
     return strCat(what, " k = ", format("%.2f", f->exponent), " (R² ", format("%.3f", f->r2), ")");
 }
 
+/// The model sweep's table: one row per scene, hair colour and mode.
+std::string modelMarkdown(const SweepOptions& o, const std::vector<BenchRow>& rows) {
+    const std::vector<std::string> scenes = sceneOrder(rows, BenchSweepKind::PathReference);
+    if (scenes.empty())
+        return {};
+    std::string md = "## Model error: dual scattering against path tracing\n\n";
+    md += strCat(
+        "The hair's radiance (the beauty without head and background) of each global-term mode "
+        "against a path trace of the same fibers with the same f_s (docs/DESIGN.md §8), "
+        "compared as means over ",
+        o.model.block, "×", o.model.block,
+        " pixel blocks. `floor`: the relative L1 the reference's own noise gives (from its "
+        "two independent halves); `noise removed`: sqrt(L1² − floor²) — an error within 1.5× "
+        "its floor is not resolved (marked ~). `bias`: signed, dual scattering brighter when "
+        "positive. Target: grid within 0.05 with the noise removed.\n\n");
+    md += "| scene, hair | mode | rel L1 | floor | noise removed | bias | DS s | reference s | "
+          "spp | Mrays/s | Mpaths/s |\n";
+    md += "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+    for (const std::string& s : scenes) {
+        const BenchRow* ref = findRow(
+            rows, s, [](const BenchRow& r) { return r.kind == BenchSweepKind::PathReference; });
+        for (const BenchRow& r : rows) {
+            if (r.scene != s || r.kind != BenchSweepKind::Model || !r.m.image)
+                continue;
+            const ImageError& e = *r.m.image;
+            const PathTraceStats* pt = ref && ref->m.pathTrace ? &*ref->m.pathTrace : nullptr;
+            md += strCat("| ", s, " | ", toString(r.config.mode), " | ", format("%.4f", e.relL1),
+                         " | ", format("%.4f", e.noiseFloorL1), " | ", e.resolved() ? "" : "~",
+                         format("%.4f", e.relL1NoiseRemoved), " | ", format("%+.4f", e.relBias),
+                         " | ", seconds(r.m.totalSeconds), " | ",
+                         ref ? seconds(ref->m.totalSeconds) : "–", " | ",
+                         pt ? std::to_string(pt->spp) : "–", " | ",
+                         pt ? format("%.2f", pt->raysPerSecond() * 1e-6) : "–", " | ",
+                         pt ? format("%.3f", pt->pathsPerSecond() * 1e-6) : "–", " |\n");
+        }
+    }
+    return md + "\n";
+}
+
 } // namespace
 
 RunInfo RunInfo::now() {
@@ -138,7 +177,14 @@ std::string csvText(const std::vector<BenchRow>& rows) {
             csvOptional(m.image ? std::optional(m.image->relL1) : std::nullopt),
             csvOptional(m.image ? std::optional(m.image->relRmse) : std::nullopt),
             csvOptional(m.probe ? std::optional(m.probe->maeV) : std::nullopt),
-            csvOptional(m.probe ? std::optional(m.probe->maeT_s) : std::nullopt)};
+            csvOptional(m.probe ? std::optional(m.probe->maeT_s) : std::nullopt),
+            csvOptional(r.eumelanin ? std::optional(double(*r.eumelanin)) : std::nullopt),
+            csvOptional(m.image ? std::optional(m.image->relBias) : std::nullopt),
+            csvOptional(m.image ? std::optional(m.image->noiseFloorL1) : std::nullopt),
+            csvOptional(m.image ? std::optional(m.image->relL1NoiseRemoved) : std::nullopt),
+            m.pathTrace ? std::to_string(m.pathTrace->spp) : "",
+            csvOptional(m.pathTrace ? std::optional(m.pathTrace->raysPerSecond()) : std::nullopt),
+            csvOptional(m.pathTrace ? std::optional(m.pathTrace->pathsPerSecond()) : std::nullopt)};
         for (std::size_t i = 0; i < cells.size(); ++i) {
             // Scene labels are the only free text: quote them if they need it.
             const bool quote = cells[i].find_first_of(",\"\n") != std::string::npos;
@@ -160,6 +206,9 @@ std::string csvText(const std::vector<BenchRow>& rows) {
 std::string configText(const BenchRow& r) {
     if (r.kind == BenchSweepKind::Reference)
         return strCat("exact K=", r.config.rays, " (reference)");
+    if (r.kind == BenchSweepKind::PathReference)
+        return strCat("path tracing", r.m.pathTrace ? strCat(" ", r.m.pathTrace->spp, " spp") : "",
+                      " (reference)");
     return r.config.label();
 }
 
@@ -189,10 +238,11 @@ std::string markdownText(const SweepOptions& o, const SweepResult& result, const
                  o.probeRays,
                  " rays over a disk of the configuration's voxel size. `grid xS`/`approx xS`: "
                  "voxel size S·h0; `exact K=n`: n rays over the h0 disk. The image reference "
-                 "is itself noisy (a few rays per shading point): its estimated share of the "
-                 "rel L1, from the error of the exact configuration with the fewest rays "
-                 "assuming variance ∝ 1/K, is the summary's last column — image errors near "
-                 "it are at the reference's noise floor.\n\n");
+                 "is itself noisy (a few rays per shading point): it is rendered as two "
+                 "independent halves of K/2 rays (different seeds), and the rel L1 its noise "
+                 "alone gives (`floor`) is measured from them and removed from every error "
+                 "(`noise removed` = sqrt(L1² − floor²), film/image_compare.h); an error within "
+                 "1.5× the floor is not resolved and is marked ~.\n\n");
 
     const std::vector<std::string> scenes = sceneOrder(rows, BenchSweepKind::Reference);
     if (!scenes.empty()) {
@@ -200,11 +250,12 @@ std::string markdownText(const SweepOptions& o, const SweepResult& result, const
         const std::uint32_t fewestRays =
             o.exactRays.empty() ? 0 : *std::min_element(o.exactRays.begin(), o.exactRays.end());
         md += strCat("## Summary (", toString(rate), " shading)\n\n");
-        md += strCat("| scene | segments | image | h0 | exact reference s | exact K=", fewestRays,
-                     " s | grid x1 s | grid speed-up: global term, total | grid x1 rel L1 | "
-                     "MAE(V) | MAE(T_s) | approx within grid's time | its rel L1 | reference "
-                     "noise (est.) |\n");
-        md += "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|\n";
+        md += strCat(
+            "| scene | segments | image | h0 | exact reference s | exact K=", fewestRays,
+            " s | grid x1 s | grid speed-up: global term, total | grid x1 rel L1 | "
+            "noise removed | floor | MAE(V) | MAE(T_s) | approx within grid's time | its rel L1 | "
+            "noise removed |\n");
+        md += "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|\n";
         for (const std::string& s : scenes) {
             const BenchRow* ref = findRow(
                 rows, s, [](const BenchRow& r) { return r.kind == BenchSweepKind::Reference; });
@@ -234,8 +285,18 @@ std::string markdownText(const SweepOptions& o, const SweepResult& result, const
             const auto relL1 = [](const BenchRow* r) {
                 return r && r->m.image ? std::optional(r->m.image->relL1) : std::nullopt;
             };
+            const auto removed = [](const BenchRow* r) {
+                if (!r || !r->m.image)
+                    return std::string("–");
+                return strCat(r->m.image->resolved() ? "" : "~",
+                              format("%.4f", r->m.image->relL1NoiseRemoved));
+            };
             line += strCat(
-                " | ", mdOptional(relL1(grid), 4), " | ",
+                " | ", mdOptional(relL1(grid), 4), " | ", removed(grid), " | ",
+                mdOptional(grid && grid->m.image ? std::optional(grid->m.image->noiseFloorL1)
+                                                 : std::nullopt,
+                           4),
+                " | ",
                 mdOptional(
                     grid && grid->m.probe ? std::optional(grid->m.probe->maeV) : std::nullopt, 4),
                 " | ",
@@ -262,16 +323,7 @@ std::string markdownText(const SweepOptions& o, const SweepResult& result, const
             line += approx ? strCat(approx->config.label(), " (", seconds(approx->m.totalSeconds),
                                     " s", withinBudget ? "" : ", none was as fast", ")")
                            : std::string("–");
-            // The reference's own noise, from the error of exact K=a against it:
-            // with independent rays, variance ∝ 1/K, so err² ≈ σ²(1/a + 1/K_ref)
-            // and the reference's share is err·sqrt(a / (a + K_ref)).
-            const std::optional<double> noise =
-                relL1(exact)
-                    ? std::optional(*relL1(exact) * std::sqrt(double(fewestRays) /
-                                                              double(fewestRays + o.referenceRays)))
-                    : std::nullopt;
-            line +=
-                strCat(" | ", mdOptional(relL1(approx), 4), " | ", mdOptional(noise, 4), " |\n");
+            line += strCat(" | ", mdOptional(relL1(approx), 4), " | ", removed(approx), " |\n");
             md += line;
         }
         md += "\n";
@@ -302,6 +354,8 @@ std::string markdownText(const SweepOptions& o, const SweepResult& result, const
         }
         md += "\n";
     }
+
+    md += modelMarkdown(o, rows);
 
     for (const ScalingFit& fit : result.fits) {
         const bool segments = fit.kind == BenchSweepKind::Segments;

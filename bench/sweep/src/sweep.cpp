@@ -83,11 +83,23 @@ Scene BenchScene::build() const {
         scene.camera.width = width;
     if (height > 0)
         scene.camera.height = height;
+    if (eumelanin)
+        scene.fiber.sigma_a = FiberParams::sigmaFromMelanin(*eumelanin, 0.0f);
     scene.name = label;
     scene.output.exr.clear();
     scene.output.png.clear();
     scene.validate();
     return scene;
+}
+
+BenchScene BenchScene::atWidth(std::uint32_t w) const {
+    BenchScene s = *this;
+    s.width = s.height = 0;
+    const Scene scene = s.build();
+    s.width = w;
+    s.height = std::max<std::uint32_t>(
+        1, std::uint32_t(std::lround(double(w) * scene.camera.height / scene.camera.width)));
+    return s;
 }
 
 std::string BenchConfig::label() const {
@@ -135,8 +147,32 @@ std::optional<PowerLawFit> fitPowerLaw(std::span<const double> x, std::span<cons
     return fit;
 }
 
-SweepOptions SweepOptions::full(const std::filesystem::path& ratboyScene) {
+namespace {
+
+/// The model sweep's scenes: the default scene, the curly close-up and Ratboy
+/// at `size` pixels wide (the scenes' own aspect).
+std::vector<BenchScene> modelScenes(const std::filesystem::path& scenesDir, std::uint32_t size,
+                                    bool withRatboy) {
+    std::vector<BenchScene> scenes;
+    const auto add = [&](const char* label, std::filesystem::path file) {
+        BenchScene s;
+        s.label = label;
+        s.file = std::move(file);
+        // A missing file is named by validate(), before any work starts.
+        scenes.push_back(std::filesystem::exists(s.file) || s.file.empty() ? s.atWidth(size) : s);
+    };
+    add("wavy (default scene)", {});
+    add("curly close-up", scenesDir / "curly_closeup.json");
+    if (withRatboy)
+        add("Ratboy mohawk", scenesDir / "ratboy_mohawk.json");
+    return scenes;
+}
+
+} // namespace
+
+SweepOptions SweepOptions::full(const std::filesystem::path& scenesDir) {
     SweepOptions o;
+    const std::filesystem::path ratboyScene = scenesDir / "ratboy_mohawk.json";
     const auto style = [](const char* label, GroomStyle s) {
         BenchScene b;
         b.label = label;
@@ -172,10 +208,13 @@ SweepOptions SweepOptions::full(const std::filesystem::path& ratboyScene) {
         s.width = s.height = size;
         o.pixelScaling.push_back(s);
     }
+    o.model.scenes = modelScenes(scenesDir, 256, true);
+    o.model.spp = 256;
+    o.model.block = 8;
     return o;
 }
 
-SweepOptions SweepOptions::quick() {
+SweepOptions SweepOptions::quick(const std::filesystem::path& scenesDir) {
     SweepOptions o;
     BenchScene wavy;
     wavy.label = "wavy (default scene) 512^2";
@@ -205,21 +244,27 @@ SweepOptions SweepOptions::quick() {
         s.width = s.height = size;
         o.pixelScaling.push_back(s);
     }
+    o.model.scenes = modelScenes(scenesDir, 128, false);
+    o.model.spp = 128;
+    o.model.block = 4;
     return o;
 }
 
 void SweepOptions::validate() const {
-    if (scenes.empty() && segmentScaling.empty() && pixelScaling.empty())
+    if (scenes.empty() && segmentScaling.empty() && pixelScaling.empty() && model.scenes.empty())
         throw InputError("bench: nothing to measure (no scenes and no scaling sweep)");
-    std::set<std::string> labels;
-    for (const auto* list : {&scenes, &segmentScaling, &pixelScaling})
+    // The model sweep's rows are labelled "<scene>, <hair>": its scenes may
+    // share labels with the accuracy sweep's, not among themselves.
+    std::set<std::string> labels, modelLabels;
+    for (const auto* list : {&scenes, &segmentScaling, &pixelScaling, &model.scenes})
         for (const BenchScene& s : *list) {
+            auto& used = list == &model.scenes ? modelLabels : labels;
             if (!s.file.empty() && !std::filesystem::exists(s.file))
                 throw InputError(strCat(s.file.string(),
                                         ": no such scene file (the default sweep "
                                         "reads data/scenes/ under the working directory: run it "
                                         "from the repository root, or pass --scene)"));
-            if (!labels.insert(s.label).second)
+            if (!used.insert(s.label).second)
                 throw InputError(strCat("bench: two scenes are labelled \"", s.label, "\""));
         }
     if (!scenes.empty() && (voxelScales.empty() || shadingRates.empty()))
@@ -238,6 +283,20 @@ void SweepOptions::validate() const {
         throw InputError(strCat("bench: singleRunAbove ", singleRunAbove, " should be ≥ 0"));
     if (outDir.empty())
         throw InputError("bench: empty output directory");
+    if (!model.scenes.empty()) {
+        if (model.melanins.empty() || model.modes.empty())
+            throw InputError("bench: the model sweep needs at least one melanin and one mode");
+        for (const auto& [name, eumelanin] : model.melanins)
+            if (name.empty() || !(eumelanin >= 0 && eumelanin <= 50))
+                throw InputError(strCat("bench: model melanin \"", name, "\" = ", eumelanin,
+                                        " should be named and in [0, 50]"));
+        if (model.spp < 2 || model.spp > 1000000)
+            throw InputError(strCat("bench: model spp ", model.spp, " outside [2, 10^6]"));
+        if (!(model.timeLimit >= 0))
+            throw InputError(strCat("bench: model time limit ", model.timeLimit, " should be ≥ 0"));
+        if (model.block < 1 || model.block > 64)
+            throw InputError(strCat("bench: model block ", model.block, " outside [1, 64]"));
+    }
 }
 
 void runBenchJobFile(const std::filesystem::path& jobFile) {
@@ -252,7 +311,7 @@ void runBenchJobFile(const std::filesystem::path& jobFile) {
 
 SweepResult runSweep(const SweepOptions& o) {
     o.validate();
-    for (const auto* list : {&o.scenes, &o.segmentScaling, &o.pixelScaling})
+    for (const auto* list : {&o.scenes, &o.segmentScaling, &o.pixelScaling, &o.model.scenes})
         for (const BenchScene& s : *list)
             s.build(); // every scene is valid before hours of work start
     std::filesystem::create_directories(o.outDir);
@@ -265,7 +324,8 @@ SweepResult runSweep(const SweepOptions& o) {
     const std::size_t perScene =
         1 + o.shadingRates.size() * (o.exactRays.size() + 2 * o.voxelScales.size());
     const std::size_t jobCount =
-        o.scenes.size() * perScene + o.segmentScaling.size() + o.pixelScaling.size();
+        o.scenes.size() * perScene + o.segmentScaling.size() + o.pixelScaling.size() +
+        o.model.scenes.size() * o.model.melanins.size() * (1 + o.model.modes.size());
     std::size_t jobIndex = 0;
     const auto start = Clock::now();
 
@@ -274,7 +334,11 @@ SweepResult runSweep(const SweepOptions& o) {
         throwIfInterrupted();
         const double load = loadAverage();
         info.loadMax = std::max(info.loadMax, load);
-        job.runs = kind == BenchSweepKind::Reference ? 1 : o.runs;
+        // References and the model sweep (whose figure is an error): one run.
+        job.runs = kind == BenchSweepKind::Reference || kind == BenchSweepKind::PathReference ||
+                           kind == BenchSweepKind::Model
+                       ? 1
+                       : o.runs;
         job.singleRunAbove = o.singleRunAbove;
         job.threads = o.threads;
         job.isolated = !o.workerCommand.empty();
@@ -290,6 +354,7 @@ SweepResult runSweep(const SweepOptions& o) {
         BenchRow row;
         row.kind = kind;
         row.scene = job.scene.label;
+        row.eumelanin = job.scene.eumelanin;
         row.config = job.config;
         const Scene scene = job.scene.build();
         row.width = scene.camera.width;
@@ -306,8 +371,15 @@ SweepResult runSweep(const SweepOptions& o) {
                            seconds(row.m.times.globalTerm), " s)");
             if (row.m.peakMiB)
                 line += strCat(", ", format("%.0f", *row.m.peakMiB), " MiB");
+            if (row.m.pathTrace)
+                line += strCat(", ", row.m.pathTrace->spp, " spp, ",
+                               format("%.2f", row.m.pathTrace->raysPerSecond() * 1e-6), " Mrays/s");
             if (row.m.image)
                 line += strCat(", rel L1 ", format("%.4f", row.m.image->relL1));
+            if (row.m.image && row.m.image->noiseFloorL1 > 0)
+                line += strCat(" (noise floor ", format("%.4f", row.m.image->noiseFloorL1),
+                               ", removed ", format("%.4f", row.m.image->relL1NoiseRemoved),
+                               ", bias ", format("%+.4f", row.m.image->relBias), ")");
             if (row.m.probe)
                 line += strCat(", MAE(V) ", format("%.4f", row.m.probe->maeV), ", MAE(T_s) ",
                                format("%.4f", row.m.probe->maeT_s));
@@ -362,6 +434,31 @@ SweepResult runSweep(const SweepOptions& o) {
             }
         }
         info.loadEnd = loadAverage(); // so far: the outputs are complete up to this scene
+        result.written = writeSweepOutputs(o, result, info, work.path());
+    }
+
+    for (std::size_t si = 0; si < o.model.scenes.size(); ++si) {
+        for (std::size_t mi = 0; mi < o.model.melanins.size(); ++mi) {
+            BenchScene scene = o.model.scenes[si];
+            scene.label = strCat(scene.label, ", ", o.model.melanins[mi].first);
+            scene.eumelanin = o.model.melanins[mi].second;
+            BenchJob ref;
+            ref.pathReference = true;
+            ref.scene = scene;
+            ref.spp = o.model.spp;
+            ref.timeLimit = o.model.timeLimit;
+            ref.referenceImage = work.path() / strCat("model-", si, "-", mi, "-reference.bin");
+            run(ref, BenchSweepKind::PathReference);
+            for (const GlobalTermMode mode : o.model.modes) {
+                BenchJob job;
+                job.scene = scene;
+                job.config = {mode, 1.0, 1, ShadingRate::Fragment};
+                job.referenceImage = ref.referenceImage;
+                job.block = o.model.block;
+                run(job, BenchSweepKind::Model);
+            }
+        }
+        info.loadEnd = loadAverage();
         result.written = writeSweepOutputs(o, result, info, work.path());
     }
 

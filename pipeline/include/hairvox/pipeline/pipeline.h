@@ -49,6 +49,11 @@ struct StageTimes {
     double total() const {
         return load + voxelize + tables + globalTerm + raster + shade + trace + write;
     }
+    StageTimes& operator+=(const StageTimes& o) {
+        load += o.load, voxelize += o.voxelize, tables += o.tables, globalTerm += o.globalTerm;
+        raster += o.raster, shade += o.shade, trace += o.trace, write += o.write;
+        return *this;
+    }
 };
 
 /// Everything a scene's global term is computed from.

@@ -58,6 +58,8 @@ struct Head {
 struct ExactSettings {
     std::uint32_t rays = 1; ///< K, [1, 65536]
     float radius = 0;       ///< r, scene units, [0, 1000]
+    /// Of the rays' jitter; renders with different seeds are independent.
+    std::uint64_t seed = 1;
 };
 
 /// How a scene is rendered: the dual-scattering rasterizer, or the path tracer
@@ -68,7 +70,9 @@ inline constexpr EnumNames<Integrator, 2> kIntegratorNames{{{
     {Integrator::DualScattering, "dual_scattering"},
     {Integrator::Path, "path"},
 }}};
-inline const char* toString(Integrator i) { return kIntegratorNames.name(i); }
+inline const char* toString(Integrator i) {
+    return kIntegratorNames.name(i);
+}
 
 struct OutputSettings {
     std::filesystem::path exr;         ///< relative to the working directory; empty: not written

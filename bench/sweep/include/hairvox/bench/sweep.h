@@ -32,6 +32,18 @@
 // growth rate of each stage's time and of peak memory as the least-squares
 // exponent k of  cost ∝ size^k  (fitPowerLaw).
 //
+// Model sweep (docs/DESIGN.md §8): how far the dual-scattering *model* is from
+// the light transport it approximates. Each scene × hair colour (a eumelanin
+// concentration) is path traced — the reference, of the same fibers with the
+// same f_s (pathtrace/), its two independent halves giving its noise — and
+// rendered with dual scattering in each global-term mode. The hair's radiance
+// (pipeline's hairRadianceOf: the beauty without head and background) is
+// compared as means over block × block pixels, where the rasterizer's point
+// sampling and the path tracer's per-pixel noise average out but a bias does
+// not: relative L1 raw, the reference's noise floor, the L1 with the noise
+// removed (film/image_compare.h) and the signed bias; with the reference's
+// time, samples, rays/s and paths/s.
+//
 // Isolation: with a worker command (the CLI passes `hairvox bench --one`),
 // every job runs in its own child process, so its peak resident memory is
 // that job's alone; without one (tests) jobs run in this process and peak
@@ -61,6 +73,7 @@
 #include <ostream>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace hairvox {
@@ -76,9 +89,14 @@ struct BenchScene {
     /// default when `style` swaps it.
     std::uint32_t pointsPerStrand = 0;
     std::uint32_t width = 0, height = 0; ///< resolution; 0: the scene's
+    /// Replaces the fiber's absorption by this eumelanin concentration (no
+    /// pheomelanin; FiberParams::sigmaFromMelanin).
+    std::optional<float> eumelanin;
 
     /// The scene with the overrides applied, validated; writes no outputs.
     Scene build() const;
+    /// This scene `width` pixels wide, its height keeping the camera's aspect.
+    BenchScene atWidth(std::uint32_t width) const;
 };
 
 /// One point of the accuracy sweep.
@@ -114,20 +132,25 @@ struct BenchMeasurement {
     double defaultVoxelSize = 0; ///< h0
     std::optional<ImageError> image;
     std::optional<ProbeError> probe;
+    std::optional<PathTraceStats> pathTrace; ///< a path-traced reference's
 };
 
 enum class BenchSweepKind {
-    Reference, ///< the scene's exact reference render (one run)
-    Accuracy,  ///< a configuration of the accuracy sweep
-    Segments,  ///< scaling with segment count
-    Pixels,    ///< scaling with image size
+    Reference,     ///< the scene's exact reference render (one run)
+    Accuracy,      ///< a configuration of the accuracy sweep
+    Segments,      ///< scaling with segment count
+    Pixels,        ///< scaling with image size
+    PathReference, ///< the model sweep's path-traced reference of a scene and hair colour
+    Model,         ///< dual scattering in one mode against that reference
 };
 
-inline constexpr EnumNames<BenchSweepKind, 4> kBenchSweepKindNames{{{
+inline constexpr EnumNames<BenchSweepKind, 6> kBenchSweepKindNames{{{
     {BenchSweepKind::Reference, "reference"},
     {BenchSweepKind::Accuracy, "accuracy"},
     {BenchSweepKind::Segments, "segments"},
     {BenchSweepKind::Pixels, "pixels"},
+    {BenchSweepKind::PathReference, "path_reference"},
+    {BenchSweepKind::Model, "model"},
 }}};
 inline const char* toString(BenchSweepKind kind) {
     return kBenchSweepKindNames.name(kind);
@@ -135,7 +158,8 @@ inline const char* toString(BenchSweepKind kind) {
 
 struct BenchRow {
     BenchSweepKind kind = BenchSweepKind::Accuracy;
-    std::string scene; ///< BenchScene::label
+    std::string scene;              ///< BenchScene::label
+    std::optional<float> eumelanin; ///< BenchScene::eumelanin
     BenchConfig config;
     std::uint32_t width = 0, height = 0;
     BenchMeasurement m;
@@ -147,12 +171,31 @@ struct ScalingFit {
     std::optional<PowerLawFit> total, voxelize, globalTerm, rasterShade, peakMemory;
 };
 
-inline constexpr std::array<const char*, 26> kBenchCsvColumns = {
-    "sweep",        "scene",    "mode",           "voxel_scale",   "voxel_size", "rays",
-    "shading_rate", "width",    "height",         "segments",      "runs",       "load_s",
-    "voxelize_s",   "tables_s", "global_term_s",  "raster_s",      "shade_s",    "write_s",
-    "total_s",      "peak_mib", "shading_points", "active_voxels", "rel_l1",     "rel_rmse",
-    "mae_v",        "mae_ts"};
+inline constexpr std::array<const char*, 33> kBenchCsvColumns = {
+    "sweep",         "scene",          "mode",
+    "voxel_scale",   "voxel_size",     "rays",
+    "shading_rate",  "width",          "height",
+    "segments",      "runs",           "load_s",
+    "voxelize_s",    "tables_s",       "global_term_s",
+    "raster_s",      "shade_s",        "write_s",
+    "total_s",       "peak_mib",       "shading_points",
+    "active_voxels", "rel_l1",         "rel_rmse",
+    "mae_v",         "mae_ts",         "eumelanin",
+    "rel_bias",      "noise_floor_l1", "rel_l1_noise_removed",
+    "spp",           "rays_per_s",     "paths_per_s"};
+
+/// The model sweep (see the file comment).
+struct ModelSweepOptions {
+    std::vector<BenchScene> scenes;
+    /// Hair colours: a name and a eumelanin concentration (no pheomelanin).
+    std::vector<std::pair<std::string, float>> melanins{
+        {"blond", 0.3f}, {"medium", 1.3f}, {"dark", 3.0f}};
+    std::vector<GlobalTermMode> modes{GlobalTermMode::Exact, GlobalTermMode::Grid,
+                                      GlobalTermMode::Approx};
+    std::uint32_t spp = 256; ///< of each path-traced reference, [2, 10^6]
+    double timeLimit = 0;    ///< seconds per reference, 0: none; the first of spp and this stops it
+    int block = 8;           ///< side in pixels of the compared blocks, [1, 64]
+};
 
 struct SweepOptions {
     std::vector<BenchScene> scenes;       ///< the accuracy sweep
@@ -165,6 +208,7 @@ struct SweepOptions {
     std::uint64_t probeSeed = 1;
     std::vector<BenchScene> segmentScaling; ///< scenes of increasing segment count
     std::vector<BenchScene> pixelScaling;   ///< scenes of increasing image size
+    ModelSweepOptions model;                ///< no scenes: no model sweep
     int runs = 3;                           ///< timed renders per configuration, [1, 100]
     /// A configuration whose first run takes longer (seconds) is run once: the
     /// exact configurations cost minutes and vary little. 0: always `runs`.
@@ -181,13 +225,16 @@ struct SweepOptions {
     /// (1024²), Ratboy_mohawk (`ratboyScene`, 960²) and the 50,000-strand ×
     /// 29-point wavy head (1.4M segments, 1920×1080); five voxel sizes; exact
     /// with 1 and 4 rays against 16; scaling 10k–1.4M segments at 1920×1080
-    /// and 256²–2048².
-    static SweepOptions full(const std::filesystem::path& ratboyScene);
+    /// and 256²–2048²; the model sweep on the default scene, the curly
+    /// close-up and Ratboy at 256² (the scenes' aspect), blond, medium and
+    /// dark, 256 spp, 8 × 8 blocks.
+    static SweepOptions full(const std::filesystem::path& scenesDir);
     /// A representative subset in under 15 minutes on 2 cores: wavy and curly
     /// at 512², voxel sizes ×4, ×2, ×1, exact with 1 ray against 4, fragment
     /// shading, one run per configuration; scaling 10k–400k segments at
-    /// 960×540 and 256²–1024².
-    static SweepOptions quick();
+    /// 960×540 and 256²–1024²; the model sweep on the default scene and the
+    /// curly close-up at 128², 128 spp, 4 × 4 blocks.
+    static SweepOptions quick(const std::filesystem::path& scenesDir);
 
     void validate() const;
 };
