@@ -23,7 +23,8 @@ std::string quoted(const std::filesystem::path& p) {
 TEST(CliCommands, RenderDefaultSceneSmall) {
     test::TempDir dir;
     const auto exr = dir / "d.exr";
-    const auto r = test::runHairvox("render --width 48 --height 48 --threads 2 -o " + quoted(exr));
+    const auto r = test::runHairvox("render --width 48 --height 48 --threads 2 -o " + quoted(exr) +
+                                    " --png " + quoted(dir / "d.png"));
     ASSERT_EQ(r.exitCode, 0) << r.output;
     EXPECT_TRUE(std::filesystem::exists(exr));
     EXPECT_TRUE(std::filesystem::exists(dir / "d.png"));
