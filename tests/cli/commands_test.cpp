@@ -105,8 +105,8 @@ TEST(CliCommands, TransmittanceWritesLitGrid) {
     const auto print = test::runShell("vdb_print -l " + quoted(vdb) + " 2>&1");
     if (print.exitCode == 127)
         GTEST_SKIP() << "vdb_print is not installed";
-    for (const char* grid : {"Name: n", "Name: V", "Name: T_s", "Name: sigma2_f", "mode: grid",
-                             "light: Light(light, point"})
+    for (const char* grid :
+         {"Name: n", "Name: V", "Name: T_s", "Name: sigma2_f", "mode: grid", "light_type: point"})
         EXPECT_NE(print.output.find(grid), std::string::npos) << grid << "\n" << print.output;
 }
 
