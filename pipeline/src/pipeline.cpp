@@ -363,7 +363,8 @@ SceneRender renderPathTraced(const Scene& scene, const PipelineOptions& options,
     result.film = std::move(traced.film);
     result.pathTrace = traced.stats;
     warnAboutLights(scene, result.warnings);
-    warnIfNoHairSeen(scene, result.film, &groom, result.warnings);
+    if (traced.stats.spp > 0) // an image without samples says nothing about what the camera sees
+        warnIfNoHairSeen(scene, result.film, &groom, result.warnings);
     for (const Light& light : scene.lights)
         result.lights.push_back({light.name, light.isDark(), 0.0, {}});
 

@@ -41,8 +41,9 @@ struct PipelineOptions {
     /// (InputError if it was rendered from another scene or seed).
     bool continuePathTrace = false;
     /// A render whose estimated memory (estimateRenderMemory) exceeds this is
-    /// refused before anything is allocated; the fiber grid gets what the
-    /// film leaves. 0: defaultMemoryLimit().
+    /// refused before anything is allocated; the fiber grid's budget
+    /// (SplatOptions::memoryBudgetBytes) shrinks to what the estimate leaves.
+    /// 0: defaultMemoryLimit() in renderScene(), no limit in loadSceneAssets().
     std::uint64_t maxMemoryBytes = 0;
 };
 
