@@ -1,15 +1,21 @@
-// hairvox render [SCENE.json] [-o OUT.exr] [--integrator dual_scattering|path]
-//                [--mode exact|grid|approx] [--spp N] [--time-limit S] [--seed S] [--continue]
-//                [--width W --height H] [--voxel-size V] [--threads N] [--quiet]
+// hairvox render [SCENE.json] [--exr OUT.exr] [--png OUT.png] [-o OUT.exr|OUT.png]
+//                [--integrator dual_scattering|path] [--mode exact|grid|approx] [--spp N]
+//                [--time-limit S] [--seed S] [--continue] [--width W] [--height H]
+//                [--voxel-size V] [--max-memory GIB] [--threads N] [--quiet]
 // Renders a scene (or the embedded default scene) to EXR + PNG and prints the
-// time per stage. A path trace stopped by Ctrl-C writes the whole passes it
-// finished and exits with 130.
+// time per stage. Outputs given on the command line replace the scene's
+// (exactly those are written); two outputs never go to the same file, nor over
+// the scene or groom file. A path trace stopped by Ctrl-C writes the whole
+// passes it finished and exits with 130.
 #include "../commands.h"
 
 #include <hairvox/core/error.h>
 #include <hairvox/core/progress.h>
 #include <hairvox/pipeline/pipeline.h>
 
+#include <algorithm>
+#include <cctype>
+#include <cmath>
 #include <cstdint>
 #include <iostream>
 #include <memory>
@@ -21,7 +27,7 @@ namespace {
 
 struct RenderCommandOptions {
     std::string scene;
-    std::string output;
+    std::string output, exr, png;
     std::string mode, integrator;
     std::optional<std::uint32_t> spp;
     std::optional<double> timeLimit;
@@ -29,9 +35,98 @@ struct RenderCommandOptions {
     bool continueRun = false;
     std::optional<std::uint32_t> width, height;
     std::optional<float> voxelSize;
+    std::optional<double> maxMemoryGiB;
     int threads = 0;
     bool quiet = false;
 };
+
+/// Two paths naming the same file (textually, or the same existing file).
+bool sameFile(const std::filesystem::path& a, const std::filesystem::path& b) {
+    std::error_code ec;
+    if (std::filesystem::absolute(a, ec).lexically_normal() ==
+        std::filesystem::absolute(b, ec).lexically_normal())
+        return true;
+    return std::filesystem::exists(a, ec) && std::filesystem::exists(b, ec) &&
+           std::filesystem::equivalent(a, b, ec);
+}
+
+std::string lowerExtension(const std::filesystem::path& p) {
+    std::string ext = p.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return ext;
+}
+
+/// The outputs: those of the command line (--exr, --png, -o by its extension)
+/// replace the scene's. Checks that something is written, that no two outputs
+/// share a file and that no output overwrites the scene or groom file.
+void resolveOutputs(const RenderCommandOptions& opt, Scene& scene) {
+    struct Output {
+        std::filesystem::path path;
+        std::string from; ///< the flag or scene field that set it, for messages
+    };
+    Output exr{scene.output.exr, "the scene's output.exr"};
+    Output png{scene.output.png, "the scene's output.png"};
+    if (!opt.output.empty() || !opt.exr.empty() || !opt.png.empty()) {
+        exr = {opt.exr, "--exr"};
+        png = {opt.png, "--png"};
+        if (!opt.output.empty()) {
+            const std::string ext = lowerExtension(opt.output);
+            Output& target = ext == ".exr" ? exr : png;
+            if (ext != ".exr" && ext != ".png")
+                throw InputError(strCat("-o ", opt.output,
+                                        ": the extension must be .exr or .png (it chooses the "
+                                        "output); or give --exr PATH and/or --png PATH"));
+            if (!target.path.empty())
+                throw InputError(strCat("-o ", opt.output, " and ", target.from, " ",
+                                        target.path.string(), " both set the ",
+                                        ext == ".exr" ? "EXR" : "PNG", " output; give one"));
+            target = {opt.output, "-o"};
+        }
+    }
+    if (exr.path.empty() && png.path.empty())
+        throw InputError(strCat(scene.name,
+                                ": output.exr and output.png are both null; nothing would be "
+                                "written (give --exr PATH or --png PATH)"));
+    if (!exr.path.empty() && !png.path.empty() && sameFile(exr.path, png.path))
+        throw InputError(strCat(exr.from, " ", exr.path.string(), " and ", png.from, " ",
+                                png.path.string(),
+                                " are the same file; the EXR and the PNG need different paths"));
+    for (const Output* o : {&exr, &png}) {
+        if (o->path.empty())
+            continue;
+        if (!opt.scene.empty() && sameFile(o->path, opt.scene))
+            throw InputError(strCat(o->from, " ", o->path.string(),
+                                    " is the scene file; it would be overwritten"));
+        if (!scene.groom.isProcedural() && sameFile(o->path, scene.groom.file))
+            throw InputError(strCat(o->from, " ", o->path.string(), " is the groom file ",
+                                    scene.groom.file.string(), "; it would be overwritten"));
+    }
+    scene.output.exr = exr.path;
+    scene.output.png = png.path;
+}
+
+/// --width or --height alone keeps the aspect ratio of the scene's camera
+/// (the other side rounded, at least 1 pixel).
+void resolveResolution(const RenderCommandOptions& opt, CameraParams& camera) {
+    const double aspect = double(camera.width) / double(camera.height);
+    if (opt.width && opt.height) {
+        camera.width = *opt.width;
+        camera.height = *opt.height;
+    } else if (opt.width) {
+        camera.width = *opt.width;
+        camera.height =
+            static_cast<std::uint32_t>(std::max(1.0, std::round(double(*opt.width) / aspect)));
+    } else if (opt.height) {
+        camera.height = *opt.height;
+        camera.width =
+            static_cast<std::uint32_t>(std::max(1.0, std::round(double(*opt.height) * aspect)));
+    }
+    if (camera.width > kMaxResolution || camera.height > kMaxResolution)
+        throw InputError(strCat(camera.width, " x ", camera.height,
+                                " (keeping the scene camera's aspect ratio): expected at most ",
+                                kMaxResolution, " pixels a side; give both --width and --height"));
+}
 
 void runRender(const RenderCommandOptions& opt) {
     Scene scene = opt.scene.empty() ? defaultScene() : loadScene(opt.scene);
@@ -49,19 +144,16 @@ void runRender(const RenderCommandOptions& opt) {
         scene.pathTrace.timeLimit = *opt.timeLimit;
     if (opt.seed)
         scene.pathTrace.seed = *opt.seed;
-    if (opt.width)
-        scene.camera.width = *opt.width;
-    if (opt.height)
-        scene.camera.height = *opt.height;
+    resolveResolution(opt, scene.camera);
     if (opt.voxelSize)
         scene.voxelSize = *opt.voxelSize;
-    if (!opt.output.empty()) {
-        scene.output.exr = opt.output;
-        scene.output.png = std::filesystem::path(opt.output).replace_extension(".png");
-    }
+    resolveOutputs(opt, scene);
     scene.validate();
 
     PipelineOptions options;
+    if (opt.maxMemoryGiB)
+        options.maxMemoryBytes =
+            static_cast<std::uint64_t>(std::max(1.0, *opt.maxMemoryGiB * double(1ull << 30)));
     options.threads = opt.threads;
     options.progress = !opt.quiet && stderrIsTerminal();
     options.continuePathTrace = opt.continueRun;
@@ -88,8 +180,12 @@ void addRenderCommand(CLI::App& app) {
         "Render a scene (default: the embedded default scene) to EXR with AOVs and a PNG");
     cmd->add_option("scene", opt->scene,
                     "Scene JSON file (docs/scene.md); omit for the default scene");
+    cmd->add_option("--exr", opt->exr,
+                    "Output EXR (beauty and AOVs). Outputs given on the command line replace "
+                    "the scene's: only they are written");
+    cmd->add_option("--png", opt->png, "Output PNG preview (tone-mapped)");
     cmd->add_option("-o,--output", opt->output,
-                    "Output EXR (the PNG preview goes beside it); default: the scene's outputs");
+                    "Output file whose extension (.exr or .png) says which output it is");
     cmd->add_option("--integrator", opt->integrator,
                     "dual_scattering (default) or path (the unbiased reference)")
         ->check(CLI::IsMember(kIntegratorNames.names()));
@@ -101,9 +197,16 @@ void addRenderCommand(CLI::App& app) {
     cmd->add_option("--seed", opt->seed, "Path tracing: random seed");
     cmd->add_flag("--continue", opt->continueRun,
                   "Path tracing: add samples to the output EXR of an earlier run of this scene");
-    cmd->add_option("--width", opt->width, "Image width in pixels")->check(CLI::Range(1u, 8192u));
-    cmd->add_option("--height", opt->height, "Image height in pixels")
+    cmd->add_option("--width", opt->width,
+                    "Image width in pixels; alone, the height follows the scene camera's aspect")
         ->check(CLI::Range(1u, 8192u));
+    cmd->add_option("--height", opt->height,
+                    "Image height in pixels; alone, the width follows the scene camera's aspect")
+        ->check(CLI::Range(1u, 8192u));
+    cmd->add_option("--max-memory", opt->maxMemoryGiB,
+                    "Refuse a render estimated to need more than this many GiB (default: 3/4 of "
+                    "the physical memory)")
+        ->check(CLI::Range(0.01, 1e6));
     cmd->add_option("--voxel-size", opt->voxelSize, "Fiber grid voxel size (scene units)")
         ->check(CLI::PositiveNumber);
     cmd->add_option("--threads", opt->threads, "Worker threads (0: all cores)")

@@ -45,6 +45,7 @@ void runTransmittance(const TransmittanceOptions& opt) {
     options.threads = opt.threads;
     const std::unique_ptr<SceneAssets> assets = loadSceneAssets(scene, options);
     if (!assets->grid) { // exact mode builds no grid: the voxels to query come from one
+        checkVoxelSizeForGroom(scene, assets->groom);
         SplatOptions splat;
         splat.voxelSize = scene.voxelSize.value_or(0.0f);
         splat.fiberScale = scene.fiberScale;
@@ -54,13 +55,9 @@ void runTransmittance(const TransmittanceOptions& opt) {
     const LitGrid lit = evaluateOnFiberGrid(*assets->grid, *assets->globalTerm->forLight(light));
     const auto evaluated = std::chrono::steady_clock::now();
     const FiberGridInfo& info = assets->grid->info;
-    writeLitGrid(opt.output, lit,
-                 {{"light", describe(light)},
-                  {"mode", toString(scene.globalTermMode)},
-                  {"voxel_size", std::to_string(info.voxelSize)},
-                  {"source_file", info.sourceFile},
-                  {"source_hash", info.sourceHash},
-                  {"hairvox_version", info.version}});
+    writeLitGrid(
+        opt.output, lit,
+        litGridMetadata(light, scene.globalTermMode, info, scene.fiber, scene.dualScattering));
     std::printf("wrote %s: global term (%s mode) at %llu voxels of %.4g toward %s\n",
                 opt.output.c_str(), toString(scene.globalTermMode),
                 static_cast<unsigned long long>(lit.stats.queries), info.voxelSize,

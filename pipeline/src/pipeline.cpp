@@ -11,10 +11,13 @@
 #include <hairvox/strands/groom_io.h>
 #include <hairvox/transmittance/exact_global_term.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <iomanip>
 #include <sstream>
+#include <unistd.h>
 
 namespace hairvox {
 
@@ -26,7 +29,116 @@ double secondsSince(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
+std::string gib(double bytes) {
+    std::ostringstream os;
+    os << std::fixed << std::setprecision(bytes < double(1ull << 30) ? 2 : 1)
+       << bytes / double(1ull << 30) << " GiB";
+    return os.str();
+}
+
+std::string vecText(const Vec3f& v) {
+    return strCat("(", v.x, ", ", v.y, ", ", v.z, ")");
+}
+
+/// Warnings about lights that cannot light anything, by name.
+void warnAboutLights(const Scene& scene, std::vector<std::string>& warnings) {
+    for (const Light& light : scene.lights) {
+        if (light.isDark())
+            warnings.push_back(strCat("light '", light.name, "' has zero intensity or colour; ",
+                                      "it lights nothing and is skipped"));
+        else if (scene.head && light.kind == Light::Kind::Point &&
+                 scene.head->sphere.contains(light.position))
+            warnings.push_back(strCat(
+                "light '", light.name, "' at ", vecText(light.position),
+                " is inside the head (center ", vecText(scene.head->sphere.center), ", radius ",
+                scene.head->sphere.radius, "); it lights nothing and is skipped"));
+    }
+}
+
+/// A warning when no pixel of the rendered image covers hair.
+void warnIfNoHairSeen(const Scene& scene, const Film& film, const Groom* groom,
+                      std::vector<std::string>& warnings) {
+    const auto hair = film.find(kHairAlphaLayer);
+    if (!hair || film.pixelCount() == 0)
+        return;
+    const std::vector<float>& a = film.layer(*hair).data;
+    if (std::any_of(a.begin(), a.end(), [](float x) { return x > 0; }))
+        return;
+    std::string bounds;
+    if (groom) {
+        const Bounds3f b = groom->bounds();
+        bounds = b.empty() ? std::string(" (the groom is empty)")
+                           : strCat(" (groom bounds ", vecText(b.min), " to ", vecText(b.max), ")");
+    }
+    warnings.push_back(strCat("the camera sees no hair: no pixel of the ", film.width(), "x",
+                              film.height(), " image covers a fiber", bounds, "; camera.position ",
+                              vecText(scene.camera.position), ", look_at ",
+                              vecText(scene.camera.lookAt), ", fov ", scene.camera.fovY));
+}
+
 } // namespace
+
+std::uint64_t defaultMemoryLimit() {
+    const long pages = sysconf(_SC_PHYS_PAGES);
+    const long pageSize = sysconf(_SC_PAGE_SIZE);
+    if (pages <= 0 || pageSize <= 0)
+        return 8ull << 30;
+    return std::uint64_t(pages) / 4 * 3 * std::uint64_t(pageSize);
+}
+
+MemoryEstimate estimateRenderMemory(const Scene& scene) {
+    MemoryEstimate m;
+    const std::uint64_t pixels = std::uint64_t(scene.camera.width) * scene.camera.height;
+    constexpr std::uint64_t kOutputBytesPerPixel = 8; // PNG pixels + its encoder; EXR in bands
+    std::uint64_t perPixel = kOutputBytesPerPixel;
+    if (scene.integrator == Integrator::Path) {
+        // 9 accumulated layers (23 channels) and the two half-sample layers
+        // (6), as floats in the film and doubles in the running sums.
+        m.filmChannels = 29;
+        perPixel += 29 * (4 + 8);
+        if (scene.output.exr.empty() ? false : std::filesystem::exists(scene.output.exr))
+            perPixel += 2 * 29 * 4; // a continued run reads the earlier EXR into a film
+    } else {
+        // beauty 3, A 1, 5 radiance components × 3, surface 3, background 3,
+        // hair.A 1, depth 1; per light V 1, n 1, T_s 3, sigma_f 3.
+        m.filmChannels = 27 + 8 * static_cast<int>(scene.lights.size());
+        perPixel += std::uint64_t(m.filmChannels) * 4;
+        if (scene.head)
+            perPixel += 5 * 4; // the head's surface layer: coverage, depth, radiance
+    }
+    m.film = pixels * perPixel;
+    // Per point: the point, its tangent and projection in the rasterizer, the
+    // segment bins and splat buckets or the ray-tracing structure.
+    constexpr std::uint64_t kBytesPerPoint = 96;
+    if (scene.groom.isProcedural()) {
+        m.groom = std::uint64_t(scene.groom.procedural.strands) *
+                  scene.groom.procedural.resolvedPointsPerStrand() * kBytesPerPoint;
+    } else {
+        std::error_code ec;
+        const std::uintmax_t size = std::filesystem::file_size(scene.groom.file, ec);
+        // A binary groom file holds 12–16 bytes per point.
+        m.groom = ec ? 0 : std::uint64_t(size) / 12 * kBytesPerPoint;
+    }
+    return m;
+}
+
+void checkVoxelSizeForGroom(const Scene& scene, const Groom& groom) {
+    if (!scene.voxelSize || groom.empty())
+        return;
+    const Vec3f extent = groom.bounds().extent();
+    const float longest = std::max({extent.x, extent.y, extent.z});
+    if (!(longest > 0))
+        return;
+    const float h = *scene.voxelSize;
+    if (longest < 2 * h)
+        throw InputError(
+            strCat(scene.name, ": grid.voxel_size = ", h,
+                   " is too large for the groom: its bounding box is ", extent.x, " x ", extent.y,
+                   " x ", extent.z, ", ", longest / h,
+                   " voxel(s) along its longest side (at least 2 are needed to resolve the hair; "
+                   "the default, \"auto\", is the longest side / ",
+                   kDefaultVoxelsAcross, " = ", longest / float(kDefaultVoxelsAcross), ")"));
+}
 
 GlobalTermSettings globalTermSettings(const Scene& scene) {
     GlobalTermSettings s;
@@ -71,6 +183,7 @@ std::unique_ptr<SceneAssets> loadSceneAssets(const Scene& scene, const PipelineO
     throwIfInterrupted();
 
     if (scene.globalTermMode != GlobalTermMode::Exact) {
+        checkVoxelSizeForGroom(scene, assets->groom);
         start = Clock::now();
         SplatOptions splat;
         splat.voxelSize = scene.voxelSize.value_or(0.0f);
@@ -79,6 +192,12 @@ std::unique_ptr<SceneAssets> loadSceneAssets(const Scene& scene, const PipelineO
         splat.sourceFile =
             scene.groom.isProcedural() ? std::string("procedural") : scene.groom.file.string();
         splat.showProgress = options.progress;
+        if (options.maxMemoryBytes > 0) {
+            const std::uint64_t used = estimateRenderMemory(scene).total();
+            splat.memoryBudgetBytes =
+                std::min(splat.memoryBudgetBytes,
+                         options.maxMemoryBytes > used ? options.maxMemoryBytes - used : 1);
+        }
         assets->grid = splatStrands(assets->groom, splat);
         assets->times.voxelize = secondsSince(start);
     }
@@ -161,7 +280,10 @@ SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& opti
         rasterize(assets->groom, camera, fragmentShader, rasterSettings(scene, options), surfaces);
     result.film = std::move(image.film);
     result.raster = image.stats;
-    result.warnings = std::move(image.warnings);
+    warnAboutLights(scene, result.warnings);
+    for (std::string& w : image.warnings)
+        result.warnings.push_back(std::move(w));
+    warnIfNoHairSeen(scene, result.film, &assets->groom, result.warnings);
 
     // The renderer's shading time includes the global-term evaluations made
     // inside the shader: apportion it by the shader's own thread time.
@@ -240,6 +362,9 @@ SceneRender renderPathTraced(const Scene& scene, const PipelineOptions& options,
     result.times.trace = secondsSince(start);
     result.film = std::move(traced.film);
     result.pathTrace = traced.stats;
+    warnAboutLights(scene, result.warnings);
+    if (traced.stats.spp > 0) // an image without samples says nothing about what the camera sees
+        warnIfNoHairSeen(scene, result.film, &groom, result.warnings);
     for (const Light& light : scene.lights)
         result.lights.push_back({light.name, light.isDark(), 0.0, {}});
 
@@ -258,9 +383,25 @@ SceneRender renderPathTraced(const Scene& scene, const PipelineOptions& options,
 
 SceneRender renderScene(const Scene& scene, const PipelineOptions& options, bool writeFiles) {
     scene.validate();
+    const std::uint64_t limit =
+        options.maxMemoryBytes > 0 ? options.maxMemoryBytes : defaultMemoryLimit();
+    const MemoryEstimate memory = estimateRenderMemory(scene);
+    if (memory.total() > limit)
+        throw InputError(strCat(scene.name, ": a ", scene.camera.width, " x ", scene.camera.height,
+                                " render would need about ", gib(double(memory.total())),
+                                " (film: ", memory.filmChannels,
+                                " float channels per pixel and the integrator's buffers, ",
+                                gib(double(memory.film)), "; groom: ", gib(double(memory.groom)),
+                                "; the rest: ", gib(double(memory.fixed)),
+                                "), over the memory limit of ", gib(double(limit)),
+                                options.maxMemoryBytes > 0 ? "" : " (3/4 of the physical memory)",
+                                "; lower the resolution or raise the limit (--max-memory GiB)"));
+    PipelineOptions withLimit = options;
+    withLimit.maxMemoryBytes = limit;
     const ThreadLimit threadLimit(options.threads);
-    return scene.integrator == Integrator::Path ? renderPathTraced(scene, options, writeFiles)
-                                                : renderDualScattering(scene, options, writeFiles);
+    return scene.integrator == Integrator::Path
+               ? renderPathTraced(scene, withLimit, writeFiles)
+               : renderDualScattering(scene, withLimit, writeFiles);
 }
 
 std::vector<std::string> hairRadianceLayers(const Film& film) {

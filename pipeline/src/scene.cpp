@@ -335,6 +335,9 @@ void Scene::validate() const {
         throw InputError(strCat("integrator: ", e.what()));
     }
     requireInRange("output.exposure", output.exposure, kExposure);
+    if (!output.exr.empty() && output.exr.lexically_normal() == output.png.lexically_normal())
+        throw InputError(strCat("output.exr and output.png are both \"", output.exr.string(),
+                                "\": the EXR and the PNG need different paths"));
 }
 
 Scene parseScene(const nlohmann::json& document, const std::string& sourceName,

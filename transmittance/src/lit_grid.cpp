@@ -1,3 +1,4 @@
+#include <hairvox/core/math.h>
 #include <hairvox/transmittance/lit_grid.h>
 
 #include <vector>
@@ -22,7 +23,7 @@ LitGrid evaluateOnFiberGrid(const FiberGrid& grid, const LightGlobalTerm& term) 
     lit.stats = term.evaluate(queries, terms);
 
     lit.n = openvdb::FloatGrid::create(0.0f);
-    lit.V = openvdb::FloatGrid::create(0.0f);
+    lit.V = openvdb::FloatGrid::create(1.0f); // outside the hair nothing blocks the light
     lit.T_s = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
     lit.sigma2_f = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
     auto n = lit.n->getAccessor();
@@ -36,25 +37,79 @@ LitGrid evaluateOnFiberGrid(const FiberGrid& grid, const LightGlobalTerm& term) 
         T_s.setValue(coords[i], openvdb::Vec3s(g.T_s.r, g.T_s.g, g.T_s.b));
         sigma2.setValue(coords[i], openvdb::Vec3s(g.sigma2_f.r, g.sigma2_f.g, g.sigma2_f.b));
     }
-    const auto name = [&](openvdb::GridBase& g, const char* gridName) {
+    const auto name = [&](openvdb::GridBase& g, const char* gridName, const char* units,
+                          const char* description) {
         g.setName(gridName);
         g.setTransform(xform.copy());
-        g.setGridClass(openvdb::GRID_FOG_VOLUME);
+        g.setGridClass(openvdb::GRID_UNKNOWN);
+        g.insertMeta("units", openvdb::StringMetadata(units));
+        g.insertMeta("description", openvdb::StringMetadata(description));
     };
-    name(*lit.n, "n");
-    name(*lit.V, "V");
-    name(*lit.T_s, "T_s");
-    name(*lit.sigma2_f, "sigma2_f");
+    name(*lit.n, "n", "fibers (dimensionless count)",
+         "expected number of fibers crossed toward the light; background 0");
+    name(*lit.V, "V", "dimensionless, [0, 1]",
+         "direct visibility e^-n toward the light; background 1 (unoccluded)");
+    name(*lit.T_s, "T_s", "dimensionless, [0, 1] per channel",
+         "forward-scattering transmittance d_f*(P - V) per colour channel; background 0");
+    name(*lit.sigma2_f, "sigma2_f", "rad^2",
+         "accumulated forward-scattering longitudinal variance per colour channel; background 0");
+    for (openvdb::GridBase* g : {static_cast<openvdb::GridBase*>(lit.T_s.get()),
+                                 static_cast<openvdb::GridBase*>(lit.sigma2_f.get())}) {
+        g->setVectorType(openvdb::VEC_INVARIANT);
+        g->insertMeta("component_order", openvdb::StringMetadata("R,G,B"));
+    }
     return lit;
 }
 
+openvdb::MetaMap litGridMetadata(const Light& light, GlobalTermMode mode, const FiberGridInfo& grid,
+                                 const FiberParams& fiber,
+                                 const DualScatteringParams& dualScattering) {
+    const auto vec = [](const Vec3f& v) {
+        return openvdb::Vec3SMetadata(openvdb::Vec3s(v.x, v.y, v.z));
+    };
+    const auto rgb = [](const Rgb& c) {
+        return openvdb::Vec3SMetadata(openvdb::Vec3s(c.r, c.g, c.b));
+    };
+    openvdb::MetaMap m;
+    m.insertMeta("light_type", openvdb::StringMetadata(kLightKindNames.name(light.kind)));
+    if (light.kind == Light::Kind::Directional)
+        m.insertMeta("light_direction", vec(light.direction));
+    else
+        m.insertMeta("light_position", vec(light.position));
+    m.insertMeta("light_color", rgb(light.color));
+    m.insertMeta("light_intensity", openvdb::FloatMetadata(light.intensity));
+    m.insertMeta("mode", openvdb::StringMetadata(toString(mode)));
+    m.insertMeta("voxel_size", openvdb::DoubleMetadata(grid.voxelSize));
+    m.insertMeta("fiber_diameter", openvdb::FloatMetadata(grid.fiberScale.diameter));
+    m.insertMeta("density_multiplier", openvdb::FloatMetadata(grid.fiberScale.densityMultiplier));
+    m.insertMeta("eta", openvdb::FloatMetadata(fiber.eta));
+    m.insertMeta("sigma_a", rgb(fiber.sigma_a));
+    m.insertMeta("eccentricity", openvdb::FloatMetadata(fiber.eccentricity));
+    m.insertMeta("alpha_R_deg", openvdb::FloatMetadata(degrees(fiber.alpha_R)));
+    m.insertMeta("beta_R_deg", openvdb::FloatMetadata(degrees(fiber.beta_R)));
+    m.insertMeta("caustic_width_deg", openvdb::FloatMetadata(degrees(fiber.causticWidth)));
+    m.insertMeta("caustic_gain", openvdb::FloatMetadata(fiber.causticGain));
+    m.insertMeta("d_f", openvdb::FloatMetadata(dualScattering.d_f));
+    m.insertMeta("d_b", openvdb::FloatMetadata(dualScattering.d_b));
+    m.insertMeta("source_file", openvdb::StringMetadata(grid.sourceFile));
+    m.insertMeta("source_hash", openvdb::StringMetadata(grid.sourceHash));
+    m.insertMeta("hairvox_version", openvdb::StringMetadata(grid.version));
+    return m;
+}
+
 void writeLitGrid(const std::filesystem::path& path, const LitGrid& lit,
-                  const std::map<std::string, std::string>& metadata) {
+                  const openvdb::MetaMap& metadata) {
     openvdb::initialize();
-    openvdb::GridPtrVec grids{lit.n, lit.V, lit.T_s, lit.sigma2_f};
-    for (const auto& g : grids)
-        for (const auto& [key, value] : metadata)
-            g->insertMeta(key, openvdb::StringMetadata(value));
+    openvdb::GridPtrVec grids;
+    for (const openvdb::GridBase::Ptr& g :
+         {openvdb::GridBase::Ptr(lit.n), openvdb::GridBase::Ptr(lit.V),
+          openvdb::GridBase::Ptr(lit.T_s), openvdb::GridBase::Ptr(lit.sigma2_f)}) {
+        // Shallow copies (shared trees) carry the metadata; the caller's grids stay as they are.
+        openvdb::GridBase::Ptr copy = g->copyGrid();
+        for (auto it = metadata.beginMeta(); it != metadata.endMeta(); ++it)
+            copy->insertMeta(it->first, *it->second);
+        grids.push_back(copy);
+    }
     writeVdbFile(path, grids);
 }
 

@@ -4,7 +4,10 @@
 // "tensorDiag" and "tensorOffDiag"; every grid carries FiberGridInfo as grid
 // metadata, so a grid copied out of the file alone keeps its provenance and
 // `vdb_print -l` or pyopenvdb show it. Counts are stored as int64 (the widest
-// integer pyopenvdb reads).
+// integer pyopenvdb reads). Each grid also says what it holds: string
+// metadata `units` and `description`, for vector grids `component_order`;
+// density is GRID_FOG_VOLUME (a density, background 0), the others
+// GRID_UNKNOWN.
 #include <hairvox/core/atomic_file.h>
 #include <hairvox/core/error.h>
 #include <hairvox/voxelize/fiber_grid.h>
@@ -39,6 +42,36 @@ void addMetadata(openvdb::GridBase& grid, const FiberGridInfo& info) {
                     openvdb::Int64Metadata(static_cast<std::int64_t>(info.segments)));
     grid.insertMeta(kMetaTotalLength, openvdb::DoubleMetadata(info.totalLength));
     grid.insertMeta(kMetaVersion, openvdb::StringMetadata(info.version));
+
+    struct Meaning {
+        const char* name;
+        const char* units;
+        const char* description;
+        const char* componentOrder; ///< null for a scalar grid
+    };
+    static constexpr Meaning kMeanings[] = {
+        {kDensityGridName, "1/length^2 (scene units)",
+         "fiber length density lambda: modeled-strand length per unit volume (a real hair "
+         "count is lambda * density_multiplier); background 0",
+         nullptr},
+        {kOrientationGridName, "dimensionless, |o| in [0, 1]",
+         "length-weighted mean unit fiber tangent E[u], root to tip; |o| is the coherence",
+         "x,y,z (world axes)"},
+        {kTensorDiagGridName, "dimensionless",
+         "diagonal of the orientation tensor E[u u^T] (symmetric, trace 1)", "xx,yy,zz"},
+        {kTensorOffDiagGridName, "dimensionless",
+         "off-diagonal of the orientation tensor E[u u^T] (symmetric: yx = xy, zx = xz, zy = yz)",
+         "xy,xz,yz"},
+    };
+    for (const Meaning& m : kMeanings) {
+        if (grid.getName() != m.name)
+            continue;
+        grid.setGridClass(m.componentOrder ? openvdb::GRID_UNKNOWN : openvdb::GRID_FOG_VOLUME);
+        grid.insertMeta("units", openvdb::StringMetadata(m.units));
+        grid.insertMeta("description", openvdb::StringMetadata(m.description));
+        if (m.componentOrder)
+            grid.insertMeta("component_order", openvdb::StringMetadata(m.componentOrder));
+    }
 }
 
 /// Reads one metadata value of the grid; InputError naming the file if absent or mistyped.

@@ -21,6 +21,7 @@
 #include <hairvox/transmittance/grid_global_term.h>
 #include <hairvox/voxelize/fiber_grid.h>
 
+#include <cstdint>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -39,7 +40,38 @@ struct PipelineOptions {
     /// Path tracing: add samples to the scene's own EXR output when it exists
     /// (InputError if it was rendered from another scene or seed).
     bool continuePathTrace = false;
+    /// A render whose estimated memory (estimateRenderMemory) exceeds this is
+    /// refused before anything is allocated; the fiber grid's budget
+    /// (SplatOptions::memoryBudgetBytes) shrinks to what the estimate leaves.
+    /// 0: defaultMemoryLimit() in renderScene(), no limit in loadSceneAssets().
+    std::uint64_t maxMemoryBytes = 0;
 };
+
+/// The default memory limit: 3/4 of the physical memory (sysconf), 8 GiB if unknown.
+std::uint64_t defaultMemoryLimit();
+
+/// What a render will allocate, estimated from the scene alone (before the
+/// groom is read): the film's AOV layers and the integrator's per-pixel
+/// buffers (float channels × pixels × 4 bytes, the path tracer's double sums),
+/// the surface layer, the output files' encoding buffers, and the groom with
+/// its per-point buffers (procedural: strands × points; a file: from its
+/// size). The fiber grid is budgeted separately by splatStrands (what the
+/// limit leaves).
+struct MemoryEstimate {
+    std::uint64_t film = 0;  ///< film layers + per-pixel integrator buffers + output encoding
+    std::uint64_t groom = 0; ///< points, per-point render buffers, acceleration structure
+    /// Libraries, tables, the fiber grid and per-light caches of a typical
+    /// groom (the default scene peaks at ~1.1 GiB at 2000², ~430 MiB at 500²).
+    std::uint64_t fixed = 320ull << 20;
+    int filmChannels = 0; ///< float channels per pixel in the film
+    std::uint64_t total() const { return film + groom + fixed; }
+};
+MemoryEstimate estimateRenderMemory(const Scene& scene);
+
+/// InputError if the scene's voxel size (when given) leaves the groom less
+/// than 2 voxels across: the grid could not resolve the hair. Names
+/// grid.voxel_size, the groom's extent and its default voxel size.
+void checkVoxelSizeForGroom(const Scene& scene, const Groom& groom);
 
 /// Wall-clock seconds per stage.
 struct StageTimes {
@@ -99,7 +131,11 @@ struct SceneRender {
     double voxelSize = 0;
 };
 
-/// Renders the scene end to end and writes its outputs (unless writeFiles is false).
+/// Renders the scene end to end and writes its outputs (unless writeFiles is
+/// false). Refuses (InputError, before allocating) a render whose
+/// estimateRenderMemory() exceeds the options' limit. Warns (SceneRender::warnings)
+/// about a light that lights nothing (inside the head, or dark) by name and
+/// about an image in which no pixel covers hair.
 SceneRender renderScene(const Scene& scene, const PipelineOptions& options, bool writeFiles = true);
 
 /// Writes the outputs the scene asks for (scene.output.exr and .png, each if
