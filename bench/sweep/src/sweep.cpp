@@ -245,7 +245,7 @@ SweepOptions SweepOptions::quick(const std::filesystem::path& scenesDir) {
         o.pixelScaling.push_back(s);
     }
     o.model.scenes = modelScenes(scenesDir, 128, false);
-    o.model.spp = 128;
+    o.model.spp = 64;
     o.model.block = 4;
     return o;
 }

@@ -233,7 +233,7 @@ struct SweepOptions {
     /// at 512², voxel sizes ×4, ×2, ×1, exact with 1 ray against 4, fragment
     /// shading, one run per configuration; scaling 10k–400k segments at
     /// 960×540 and 256²–1024²; the model sweep on the default scene and the
-    /// curly close-up at 128², 128 spp, 4 × 4 blocks.
+    /// curly close-up at 128², 64 spp, 4 × 4 blocks.
     static SweepOptions quick(const std::filesystem::path& scenesDir);
 
     void validate() const;
