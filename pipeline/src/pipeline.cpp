@@ -11,10 +11,13 @@
 #include <hairvox/strands/groom_io.h>
 #include <hairvox/transmittance/exact_global_term.h>
 
+#include <tbb/task_group.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <exception>
 #include <iomanip>
 #include <sstream>
 #include <unistd.h>
@@ -446,11 +449,13 @@ std::string pathTraceHash(const Scene& scene, const Groom& groom) {
     return hexDigest(h.digest());
 }
 
-std::vector<std::filesystem::path> writeOutputs(const Film& film, const Scene& scene,
-                                                const std::map<std::string, std::string>& extra) {
-    std::vector<std::filesystem::path> written;
+namespace {
+
+void writeExrOutput(const Film& film, const Scene& scene,
+                    const std::map<std::string, std::string>& extra) {
     if (!scene.output.exr.empty()) {
         ExrHeader header;
+        header.zipLevel = scene.output.exrZipLevel;
         header.worldToCamera = Camera(scene.camera).worldToCameraMatrix();
         header.attributes = {{"hairvox:scene", scene.name},
                              {"hairvox:integrator", toString(scene.integrator)}};
@@ -463,13 +468,40 @@ std::vector<std::filesystem::path> writeOutputs(const Film& film, const Scene& s
         for (const auto& [key, value] : extra)
             header.attributes[key] = value;
         writeExr(scene.output.exr, film, header);
+    }
+}
+
+} // namespace
+
+std::vector<std::filesystem::path> writeOutputs(const Film& film, const Scene& scene,
+                                                const std::map<std::string, std::string>& extra) {
+    std::vector<std::filesystem::path> written;
+    // The PNG is encoded while the EXR is written (each atomically); an error
+    // in either is reported once both have finished.
+    tbb::task_group png;
+    std::exception_ptr pngError;
+    if (!scene.output.png.empty())
+        png.run([&] {
+            try {
+                writePng(scene.output.png, film.width(), film.height(),
+                         previewPixels(film, scene.output.exposure, scene.output.toneMap));
+            } catch (...) {
+                pngError = std::current_exception();
+            }
+        });
+    try {
+        writeExrOutput(film, scene, extra);
+    } catch (...) {
+        png.wait();
+        throw;
+    }
+    png.wait();
+    if (pngError)
+        std::rethrow_exception(pngError);
+    if (!scene.output.exr.empty())
         written.push_back(scene.output.exr);
-    }
-    if (!scene.output.png.empty()) {
-        writePng(scene.output.png, film.width(), film.height(),
-                 previewPixels(film, scene.output.exposure, scene.output.toneMap));
+    if (!scene.output.png.empty())
         written.push_back(scene.output.png);
-    }
     return written;
 }
 

@@ -275,6 +275,8 @@ OutputSettings parseOutput(JsonObject obj, const std::string& stem) {
         o.exposure = v.numberF(kExposure);
     if (const JsonValue v = obj["tone_map"]; v.present())
         o.toneMap = v.oneOf(kToneMapNames);
+    if (const JsonValue v = obj["exr_zip_level"]; v.present())
+        o.exrZipLevel = static_cast<int>(v.integer(1, 9));
     obj.finish();
     return o;
 }
@@ -335,6 +337,9 @@ void Scene::validate() const {
         throw InputError(strCat("integrator: ", e.what()));
     }
     requireInRange("output.exposure", output.exposure, kExposure);
+    if (output.exrZipLevel < 1 || output.exrZipLevel > 9)
+        throw InputError(strCat("output.exr_zip_level = ", output.exrZipLevel,
+                                " should be in the range [1, 9]"));
     if (!output.exr.empty() && output.exr.lexically_normal() == output.png.lexically_normal())
         throw InputError(strCat("output.exr and output.png are both \"", output.exr.string(),
                                 "\": the EXR and the PNG need different paths"));

@@ -92,6 +92,34 @@ TEST(ExrFile, BytesDoNotDependOnTheThreadCount) {
     EXPECT_EQ(bytes(4), one);
 }
 
+TEST(ExrFile, ZipLevelTradesSizeAndIsChecked) {
+    // A smooth image (as renders are), taller than one band of rows.
+    Film film(300, 600);
+    FilmLayer& beauty = film.layer(film.addLayer(std::string(Film::kBeauty), 3));
+    for (std::size_t i = 0; i < beauty.data.size(); ++i)
+        beauty.data[i] = 0.5f + 0.4f * std::sin(0.001f * float(i));
+    test::TempDir dir;
+    std::uintmax_t size[10] = {};
+    for (const int level : {1, 9}) {
+        ExrHeader header;
+        header.zipLevel = level;
+        const auto path = dir / strCat("level", level, ".exr");
+        writeExr(path, film, header);
+        size[level] = std::filesystem::file_size(path);
+        const std::vector<float> g = readExr(path).channels.at("G");
+        ASSERT_EQ(g.size(), film.pixelCount());
+        float worst = 0; // lossless up to half's rounding, at any level
+        for (std::size_t p = 0; p < g.size(); ++p)
+            worst = std::max(worst, std::abs(g[p] - beauty.data[3 * p + 1]));
+        EXPECT_LT(worst, 1e-3f) << level;
+    }
+    EXPECT_LE(size[9], size[1]);
+    ExrHeader bad;
+    bad.zipLevel = 0;
+    EXPECT_THROW(writeExr(dir / "bad.exr", film, bad), InputError);
+    EXPECT_FALSE(std::filesystem::exists(dir / "bad.exr"));
+}
+
 TEST(ExrFile, KeepsValuesBeyondHalfRange) {
     Film film(4, 2);
     film.addLayer(std::string(Film::kBeauty), 3);

@@ -1,6 +1,7 @@
 // The path tracer (pathtrace/path_tracer.h): coverage and single scattering of
 // simple fibers against closed forms, the halves' noise estimate, continuation
 // and determinism.
+#include "film/film_bytes.h"
 #include "test_util.h"
 
 #include <hairvox/core/error.h>
@@ -11,11 +12,10 @@
 #include <hairvox/shading/marschner.h>
 #include <hairvox/strands/procedural.h>
 
-#include <cstring>
-
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 
 namespace hairvox {
 namespace {
@@ -67,7 +67,8 @@ TEST(PathTracer, OneFiberSingleScatteringIsMarschner) {
     const int size = 65; // pixel centres on the fiber's row
     PathTraceScene scene = fiberScene(groom, 2e-3f, size);
     scene.camera.position = Vec3f(0.0f, 0.05f, 1.0f);
-    scene.lights = {Light::directional(Vec3f(0.2f, 0.3f, -1.0f)), Light::directional(Vec3f(-0.4f, 0.7f, 0.5f))};
+    scene.lights = {Light::directional(Vec3f(0.2f, 0.3f, -1.0f)),
+                    Light::directional(Vec3f(-0.4f, 0.7f, 0.5f))};
     scene.lights[0].intensity = 2.0f;
     scene.lights[1].name = "front";
     PathTraceSettings settings;
@@ -87,8 +88,8 @@ TEST(PathTracer, OneFiberSingleScatteringIsMarschner) {
         const float alpha = film.layer("hair.A").scalar(i);
         coverage += double(alpha);
         for (const Light& l : scene.lights) {
-            const FiberAngles fa = FiberAngles::fromDirections(l.direction, glm::normalize(camera.position() - p),
-                                                               Vec3f(1, 0, 0));
+            const FiberAngles fa = FiberAngles::fromDirections(
+                l.direction, glm::normalize(camera.position() - p), Vec3f(1, 0, 0));
             const LobeValues f = bcsdf.eval(fa);
             for (Lobe lobe : kLobes)
                 expected[lobe] += alpha * l.intensity * fa.cosTheta_i * f[lobe];
@@ -134,15 +135,6 @@ struct SmallScene {
     }
 };
 
-std::vector<unsigned char> filmBytes(const Film& film) {
-    std::vector<unsigned char> bytes;
-    for (const FilmLayer& layer : film.layers()) {
-        const auto* p = reinterpret_cast<const unsigned char*>(layer.data.data());
-        bytes.insert(bytes.end(), p, p + layer.data.size() * sizeof(float));
-    }
-    return bytes;
-}
-
 TEST(PathTracer, SameBytesForAnyThreadCount) {
     const SmallScene s;
     PathTraceSettings settings;
@@ -154,12 +146,13 @@ TEST(PathTracer, SameBytesForAnyThreadCount) {
         EXPECT_EQ(out.stats.spp, 4u);
         EXPECT_GT(out.stats.scatteringEvents, out.stats.paths / 4);
         if (reference.empty())
-            reference = filmBytes(out.film);
+            reference = test::filmBytes(out.film);
         else
-            EXPECT_TRUE(filmBytes(out.film) == reference) << threads << " threads";
+            EXPECT_TRUE(test::filmBytes(out.film) == reference) << threads << " threads";
     }
     settings.seed = 2;
-    EXPECT_FALSE(filmBytes(pathTrace(s.scene, settings).film) == reference); // the seed matters
+    EXPECT_FALSE(test::filmBytes(pathTrace(s.scene, settings).film) ==
+                 reference); // the seed matters
 }
 
 // A run continued from its own output is the run that was never stopped (up
@@ -226,7 +219,8 @@ TEST(PathTracer, RussianRouletteIsUnbiased) {
     const ImageError e = *compareImages(x, y);
     // Both are noisy: the bias of one against the other is zero within the
     // two images' noise (its standard error, from the halves, ≈ floor/√(π/2)·…).
-    EXPECT_LT(std::abs(e.relBias), 0.03) << "relative bias " << e.relBias << ", floor " << e.noiseFloorL1;
+    EXPECT_LT(std::abs(e.relBias), 0.03)
+        << "relative bias " << e.relBias << ", floor " << e.noiseFloorL1;
     EXPECT_LT(e.relL1, 1.6 * std::sqrt(2.0) * e.noiseFloorL1) << "floor " << e.noiseFloorL1;
     // Roulette from the first bounce makes shorter paths on average.
     EXPECT_LT(a.stats.scatteringEvents, b.stats.scatteringEvents);

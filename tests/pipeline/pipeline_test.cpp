@@ -2,6 +2,7 @@
 // term (pipeline/pipeline.h): layers, the radiance of a fiber against the
 // shader evaluated directly, light and shadow cases, the head, determinism and
 // the reference image.
+#include "film/film_bytes.h"
 #include "test_util.h"
 
 #include <hairvox/core/math.h>
@@ -226,24 +227,14 @@ TEST(RenderPipeline, HeadIsLambertianAndHidesTheHairBehindIt) {
     EXPECT_GT(r.raster->segmentTilesBehindSurfaces, 0u);
 }
 
-/// Every layer of the film, concatenated as bytes.
-std::vector<unsigned char> filmBytes(const Film& film) {
-    std::vector<unsigned char> bytes;
-    for (const FilmLayer& layer : film.layers()) {
-        const auto* p = reinterpret_cast<const unsigned char*>(layer.data.data());
-        bytes.insert(bytes.end(), p, p + layer.data.size() * sizeof(float));
-    }
-    return bytes;
-}
-
 TEST(RenderPipeline, SameBytesForAnyThreadCount) {
     test::TempDir dir;
     const Scene scene = smallScene(dir);
     const std::vector<unsigned char> one =
-        filmBytes(renderScene(scene, options(dir, 1), false).film);
+        test::filmBytes(renderScene(scene, options(dir, 1), false).film);
     EXPECT_GT(one.size(), 96u * 96u * 4u);
     for (const int threads : {2, 8})
-        EXPECT_TRUE(filmBytes(renderScene(scene, options(dir, threads), false).film) == one)
+        EXPECT_TRUE(test::filmBytes(renderScene(scene, options(dir, threads), false).film) == one)
             << threads << " threads";
 }
 

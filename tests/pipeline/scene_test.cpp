@@ -73,10 +73,15 @@ TEST(Scene, EveryFeatureParses) {
     j["lights"][0]["color"] = {1, 0.9, 0.8};
     j["head"] = {{"center", {0, 0, -0.5}}, {"radius", 0.1}, {"color", {0.5, 0.4, 0.3}}};
     j["grid"] = {{"voxel_size", 0.002}};
-    j["global_term"] = {{"mode", "exact"}, {"exact", {{"rays", 8}, {"radius", 0.001}}}};
+    j["global_term"] = {{"mode", "exact"},
+                        {"exact", {{"rays", 8}, {"radius", 0.001}, {"seed", 5}}}};
     j["shading_rate"] = "vertex";
     j["background"] = {0.1, 0.1, 0.1};
-    j["output"] = {{"exr", "a/b.exr"}, {"png", nullptr}, {"exposure", 1.5}, {"tone_map", "clamp"}};
+    j["output"] = {{"exr", "a/b.exr"},
+                   {"png", nullptr},
+                   {"exposure", 1.5},
+                   {"tone_map", "clamp"},
+                   {"exr_zip_level", 6}};
     const Scene s = parseScene(j, "scene.json", "/scenes");
     EXPECT_EQ(s.groom.file, std::filesystem::path("/scenes/grooms/a.hair"));
     EXPECT_FLOAT_EQ(s.fiberScale.diameter, 8e-5f);
@@ -91,9 +96,13 @@ TEST(Scene, EveryFeatureParses) {
     EXPECT_FLOAT_EQ(*s.voxelSize, 0.002f);
     EXPECT_EQ(s.globalTermMode, GlobalTermMode::Exact);
     EXPECT_EQ(s.exact.rays, 8u);
+    EXPECT_EQ(s.exact.seed, 5u);
+    EXPECT_EQ(s.output.exrZipLevel, 6);
     EXPECT_EQ(s.shadingRate, ShadingRate::Vertex);
     EXPECT_TRUE(s.output.png.empty());
     EXPECT_EQ(s.output.toneMap, ToneMap::Clamp);
+    j["output"]["exr_zip_level"] = 10;
+    EXPECT_THROW(parseScene(j, "scene.json", "/scenes"), InputError);
 }
 
 TEST(Scene, DirectionalLightPointsTowardTheLightAndIsNormalised) {

@@ -1,3 +1,4 @@
+#include "film/film_bytes.h"
 #include "render/test_shaders.h"
 
 #include <hairvox/core/error.h>
@@ -331,16 +332,6 @@ TEST(RasterSurfaces, WrongSizeIsAnInputError) {
     EXPECT_THROW(rasterize(Groom{}, camera, shader, testSettings(1e-3f), bad), InputError);
 }
 
-/// Every layer of the film, concatenated as bytes.
-std::vector<unsigned char> filmBytes(const Film& film) {
-    std::vector<unsigned char> bytes;
-    for (const FilmLayer& layer : film.layers()) {
-        const auto* p = reinterpret_cast<const unsigned char*>(layer.data.data());
-        bytes.insert(bytes.end(), p, p + layer.data.size() * sizeof(float));
-    }
-    return bytes;
-}
-
 Camera groomCamera(std::uint32_t size) {
     return testCamera(size, size, Vec3f(0.45f, 0.05f, -0.6f), Vec3f(0.0f, -0.1f, -0.05f));
 }
@@ -369,9 +360,9 @@ TEST(RasterDeterminism, SameBytesForAnyThreadCount) {
             EXPECT_GT(out.stats.fragmentsComposited, 10000u);
             EXPECT_GT(out.stats.fragmentsBehindOpaque, 0u);
             if (reference.empty())
-                reference = filmBytes(out.film);
+                reference = test::filmBytes(out.film);
             else
-                EXPECT_TRUE(filmBytes(out.film) == reference) << threads << " threads";
+                EXPECT_TRUE(test::filmBytes(out.film) == reference) << threads << " threads";
         }
     }
 }

@@ -39,12 +39,21 @@ inline const char* toString(ToneMap t) {
 /// Row-major 4×4 matrix, OpenEXR's convention (row vectors).
 using Matrix44 = std::array<std::array<float, 4>, 4>;
 
+/// The EXR's zlib level unless a scene says otherwise (measured: ExrHeader).
+inline constexpr int kDefaultExrZipLevel = 1;
+
 struct ExrHeader {
     std::optional<Matrix44> worldToCamera;
     std::map<std::string, std::string> attributes; ///< e.g. "hairvox:globalTermMode" → "grid"
+    /// zlib level of the ZIPS compression, [1, 9]. Measured on the default
+    /// scene at 1024² (43 channels, 2 cores, `hairvox render`'s write stage,
+    /// EXR alone): level 1 0.61–0.73 s for 18.7 MB, level 4 (OpenEXR's
+    /// default) 0.78–1.10 s for 18.0 MB.
+    int zipLevel = kDefaultExrZipLevel;
 };
 
 /// Writes every layer of the film as one multi-layer EXR, atomically.
+/// InputError if header.zipLevel is outside [1, 9].
 void writeExr(const std::filesystem::path& path, const Film& film, const ExrHeader& header = {});
 
 /// An EXR file read back: every channel as float, row-major, and the string

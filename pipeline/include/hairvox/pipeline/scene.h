@@ -79,6 +79,7 @@ struct OutputSettings {
     std::filesystem::path png;         ///< relative to the working directory; empty: not written
     float exposure = 0;                ///< stops applied to the PNG preview only, [-20, 20]
     ToneMap toneMap = ToneMap::Filmic; ///< of the PNG preview (film/image_file.h)
+    int exrZipLevel = kDefaultExrZipLevel; ///< zlib level of the EXR, [1, 9] (ExrHeader)
 };
 
 struct Scene {

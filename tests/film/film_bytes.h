@@ -1,0 +1,20 @@
+// Tests' helper: a film as bytes, for "same bytes for any thread count".
+#pragma once
+
+#include <hairvox/film/film.h>
+
+#include <vector>
+
+namespace hairvox::test {
+
+/// Every layer of the film, concatenated as bytes.
+inline std::vector<unsigned char> filmBytes(const Film& film) {
+    std::vector<unsigned char> bytes;
+    for (const FilmLayer& layer : film.layers()) {
+        const auto* p = reinterpret_cast<const unsigned char*>(layer.data.data());
+        bytes.insert(bytes.end(), p, p + layer.data.size() * sizeof(float));
+    }
+    return bytes;
+}
+
+} // namespace hairvox::test
