@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <stdexcept>
 
 namespace hairvox {
@@ -41,23 +42,42 @@ std::vector<std::uint8_t> previewPixels(const Film& film, float exposure, ToneMa
     return out;
 }
 
-void writePng(const std::filesystem::path& path, int width, int height,
-              const std::vector<std::uint8_t>& rgb) {
+std::vector<std::uint8_t> encodePng(int width, int height, const std::vector<std::uint8_t>& rgb) {
     if (width < 0 || height < 0 || rgb.size() != std::size_t(width) * std::size_t(height) * 3)
         throw std::logic_error(
-            strCat("writePng: ", rgb.size(), " bytes for ", width, " x ", height));
-    writeFileAtomically(path, [&](const std::filesystem::path& tmp) {
-        png_image image{};
-        image.version = PNG_IMAGE_VERSION;
-        image.width = static_cast<png_uint_32>(width);
-        image.height = static_cast<png_uint_32>(height);
-        image.format = PNG_FORMAT_RGB;
-        if (!png_image_write_to_file(&image, tmp.c_str(), 0, rgb.data(), 0, nullptr)) {
-            const std::string message = image.message;
-            png_image_free(&image);
-            throw InputError(strCat(path.string(), ": cannot write PNG file: ", message));
+            strCat("encodePng: ", rgb.size(), " bytes for ", width, " x ", height));
+    png_image image{};
+    image.version = PNG_IMAGE_VERSION;
+    image.width = static_cast<png_uint_32>(width);
+    image.height = static_cast<png_uint_32>(height);
+    image.format = PNG_FORMAT_RGB;
+    png_alloc_size_t size = 0; // first the size, then the bytes
+    std::vector<std::uint8_t> png;
+    if (png_image_write_to_memory(&image, nullptr, &size, 0, rgb.data(), 0, nullptr)) {
+        png.resize(size);
+        if (png_image_write_to_memory(&image, png.data(), &size, 0, rgb.data(), 0, nullptr)) {
+            png.resize(size);
+            return png;
         }
+    }
+    const std::string message = image.message;
+    png_image_free(&image);
+    throw InputError(strCat("cannot encode PNG: ", message));
+}
+
+void writeEncodedPng(const std::filesystem::path& path, const std::vector<std::uint8_t>& png) {
+    writeFileAtomically(path, [&](const std::filesystem::path& tmp) {
+        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+        out.write(reinterpret_cast<const char*>(png.data()), std::streamsize(png.size()));
+        out.close();
+        if (!out)
+            throw InputError(strCat(path.string(), ": cannot write PNG file"));
     });
+}
+
+void writePng(const std::filesystem::path& path, int width, int height,
+              const std::vector<std::uint8_t>& rgb) {
+    writeEncodedPng(path, encodePng(width, height, rgb));
 }
 
 } // namespace hairvox

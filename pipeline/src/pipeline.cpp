@@ -476,15 +476,17 @@ void writeExrOutput(const Film& film, const Scene& scene,
 std::vector<std::filesystem::path> writeOutputs(const Film& film, const Scene& scene,
                                                 const std::map<std::string, std::string>& extra) {
     std::vector<std::filesystem::path> written;
-    // The PNG is encoded while the EXR is written (each atomically); an error
-    // in either is reported once both have finished.
-    tbb::task_group png;
+    // The PNG is encoded while the EXR is written, and written (atomically)
+    // only once the EXR is: an interrupted or failed EXR leaves both outputs
+    // as they were.
+    tbb::task_group encoding;
+    std::vector<std::uint8_t> png;
     std::exception_ptr pngError;
     if (!scene.output.png.empty())
-        png.run([&] {
+        encoding.run([&] {
             try {
-                writePng(scene.output.png, film.width(), film.height(),
-                         previewPixels(film, scene.output.exposure, scene.output.toneMap));
+                png = encodePng(film.width(), film.height(),
+                                previewPixels(film, scene.output.exposure, scene.output.toneMap));
             } catch (...) {
                 pngError = std::current_exception();
             }
@@ -492,12 +494,14 @@ std::vector<std::filesystem::path> writeOutputs(const Film& film, const Scene& s
     try {
         writeExrOutput(film, scene, extra);
     } catch (...) {
-        png.wait();
+        encoding.wait();
         throw;
     }
-    png.wait();
+    encoding.wait();
     if (pngError)
         std::rethrow_exception(pngError);
+    if (!scene.output.png.empty())
+        writeEncodedPng(scene.output.png, png);
     if (!scene.output.exr.empty())
         written.push_back(scene.output.exr);
     if (!scene.output.png.empty())

@@ -75,8 +75,13 @@ Film filmFromExr(const ExrImage& image);
 /// The tone-mapped 8-bit sRGB preview of the film's beauty, row-major RGB.
 std::vector<std::uint8_t> previewPixels(const Film& film, float exposure, ToneMap toneMap);
 
-/// Writes 8-bit RGB pixels (row-major, 3 bytes a pixel) as a PNG, atomically.
+/// Writes 8-bit RGB pixels (row-major, 3 bytes a pixel) as a PNG, atomically:
+/// writeEncodedPng(path, encodePng(width, height, rgb)).
 void writePng(const std::filesystem::path& path, int width, int height,
               const std::vector<std::uint8_t>& rgb);
+/// The PNG file's bytes for 8-bit RGB pixels (the expensive half: deflate).
+std::vector<std::uint8_t> encodePng(int width, int height, const std::vector<std::uint8_t>& rgb);
+/// Writes encoded PNG bytes atomically.
+void writeEncodedPng(const std::filesystem::path& path, const std::vector<std::uint8_t>& png);
 
 } // namespace hairvox
