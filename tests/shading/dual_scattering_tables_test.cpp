@@ -23,9 +23,9 @@ namespace {
 using Sample = DualScatteringTables::Sample;
 
 const std::vector<Rgb Sample::*> kAllFields{
-    &Sample::aBar_f,     &Sample::aBar_b,     &Sample::alphaBar_f, &Sample::alphaBar_b,
-    &Sample::beta2Bar_f, &Sample::beta2Bar_b, &Sample::ABar_b,     &Sample::DeltaBar_b,
-    &Sample::sigma2Bar_b};
+    &Sample::aBar_f,     &Sample::aBar_b,     &Sample::alphaBar_f,
+    &Sample::alphaBar_b, &Sample::beta2Bar_f, &Sample::beta2Bar_b,
+    &Sample::ABar_b,     &Sample::DeltaBar_b, &Sample::sigma2Bar_b};
 
 std::string readFile(const std::filesystem::path& path) {
     std::ifstream in(path, std::ios::binary);
@@ -149,7 +149,8 @@ TEST(DualScatteringTables, BackscatteringTermsFiniteAndPlausible) {
                         ASSERT_GT(s.beta2Bar_f[c], 0.0f) << s;
                         ASSERT_GT(s.beta2Bar_b[c], 0.0f) << s;
                         // σ̄_b is a spread of back-scattered light, at least β̄_b.
-                        ASSERT_GE(std::sqrt(s.sigma2Bar_b[c]), std::sqrt(s.beta2Bar_b[c]) * 0.999f) << s;
+                        ASSERT_GE(std::sqrt(s.sigma2Bar_b[c]), std::sqrt(s.beta2Bar_b[c]) * 0.999f)
+                            << s;
                         ASSERT_LT(s.sigma2Bar_b[c], 25.0f) << s;
                         ASSERT_LE(std::abs(s.DeltaBar_b[c]), static_cast<float>(PiOver2)) << s;
                         // Averages of α_p and β_p² lie between the lobes' values.
@@ -236,7 +237,8 @@ TEST(DualScatteringTables, EccentricTablesAverageOverOrientation) {
         const int orientations = 8;
         for (int k = 0; k < orientations; ++k) {
             const test::HalfAlbedo a = test::integrateOverSphere(
-                radians(thetaDeg), 240, 360, [&](const FiberAngles& x) { return bcsdf.eval(x).sum(); },
+                radians(thetaDeg), 240, 360,
+                [&](const FiberAngles& x) { return bcsdf.eval(x).sum(); },
                 Pi * (k + 0.5) / orientations);
             back += a.back / double(orientations);
             front += a.front / double(orientations);
@@ -274,12 +276,14 @@ TEST(DualScatteringTables, LookupInterpolatesAndClamps) {
         for (float sign : {1.0f, -1.0f}) {
             const LobeValues ng = t.NG(t.theta(4), sign * phi);
             for (int c = 0; c < 3; ++c)
-                EXPECT_NEAR(ng.TT[c], t.NGSample(4, j).TT[c], 1e-5f * t.NGSample(4, j).TT[c] + 1e-9f);
+                EXPECT_NEAR(ng.TT[c], t.NGSample(4, j).TT[c],
+                            1e-5f * t.NGSample(4, j).TT[c] + 1e-9f);
         }
     }
-    EXPECT_TRUE(t.NG(std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::quiet_NaN())
-                    .sum()
-                    .isFinite());
+    EXPECT_TRUE(
+        t.NG(std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::quiet_NaN())
+            .sum()
+            .isFinite());
 }
 
 TEST(DualScatteringTables, DeterministicForAnyThreadCount) {
@@ -333,13 +337,15 @@ TEST(DualScatteringTablesCache, SecondRunLoadsInsteadOfRebuilding) {
     test::TempDir dir;
     TableBuildOptions o;
     o.thetaSamples = 19;
-    const DualScatteringTables first = DualScatteringTables::loadOrBuild(FiberParams{}, dir.path(), o);
+    const DualScatteringTables first =
+        DualScatteringTables::loadOrBuild(FiberParams{}, dir.path(), o);
     EXPECT_FALSE(first.loadedFromCache());
     const auto file = DualScatteringTables::cacheFile(dir.path(), FiberParams{}, o);
     ASSERT_TRUE(std::filesystem::exists(file));
     const auto written = std::filesystem::last_write_time(file);
 
-    const DualScatteringTables second = DualScatteringTables::loadOrBuild(FiberParams{}, dir.path(), o);
+    const DualScatteringTables second =
+        DualScatteringTables::loadOrBuild(FiberParams{}, dir.path(), o);
     EXPECT_TRUE(second.loadedFromCache());
     EXPECT_EQ(std::filesystem::last_write_time(file), written);
     for (int k = 0; k < first.size(); ++k)
@@ -359,19 +365,23 @@ TEST(DualScatteringTablesCache, CorruptOrTruncatedFilesAreRebuilt) {
     test::TempDir dir;
     TableBuildOptions o;
     o.thetaSamples = 19;
-    const DualScatteringTables good = DualScatteringTables::loadOrBuild(FiberParams{}, dir.path(), o);
+    const DualScatteringTables good =
+        DualScatteringTables::loadOrBuild(FiberParams{}, dir.path(), o);
     const auto file = DualScatteringTables::cacheFile(dir.path(), FiberParams{}, o);
     const std::string bytes = readFile(file);
 
     std::string corrupt = bytes;
     corrupt[bytes.size() / 2] = static_cast<char>(corrupt[bytes.size() / 2] ^ 0x10);
-    for (const std::string& damaged : {corrupt, bytes.substr(0, bytes.size() - 9), std::string("junk")}) {
+    for (const std::string& damaged :
+         {corrupt, bytes.substr(0, bytes.size() - 9), std::string("junk")}) {
         test::ByteWriter().putBytes(damaged.data(), damaged.size()).writeTo(file);
-        const DualScatteringTables t = DualScatteringTables::loadOrBuild(FiberParams{}, dir.path(), o);
+        const DualScatteringTables t =
+            DualScatteringTables::loadOrBuild(FiberParams{}, dir.path(), o);
         EXPECT_FALSE(t.loadedFromCache());
         EXPECT_EQ(t.sample(9).aBar_f, good.sample(9).aBar_f);
         EXPECT_EQ(readFile(file), bytes); // rewritten whole
-        EXPECT_TRUE(DualScatteringTables::loadOrBuild(FiberParams{}, dir.path(), o).loadedFromCache());
+        EXPECT_TRUE(
+            DualScatteringTables::loadOrBuild(FiberParams{}, dir.path(), o).loadedFromCache());
     }
 }
 
@@ -421,6 +431,17 @@ constexpr const char* kHeader =
     "beta2f_r,beta2f_g,beta2f_b,beta2b_r,beta2b_g,beta2b_b,Ab_r,Ab_g,Ab_b,Deltab_r,Deltab_g,"
     "Deltab_b,sigma2b_r,sigma2b_g,sigma2b_b";
 
+/// kHeader followed by N^G per lobe at φ = 0°, 5°, …, 180° and channel.
+std::string csvHeader() {
+    std::string header = kHeader;
+    for (const char* lobe : {"NGR", "NGTT", "NGTRT"})
+        for (int deg = 0; deg <= 180; deg += 5)
+            for (const char* c : {"_r", "_g", "_b"})
+                header +=
+                    strCat(",", lobe, "_phi", deg < 100 ? "0" : "", deg < 10 ? "0" : "", deg, c);
+    return header;
+}
+
 TEST(DualScatteringTables, WritesCsv) {
     test::TempDir dir;
     TableBuildOptions o;
@@ -429,12 +450,7 @@ TEST(DualScatteringTables, WritesCsv) {
     t.writeCsv(dir / "t.csv");
     const std::vector<std::string> lines = csvLines(dir / "t.csv");
     ASSERT_EQ(lines.size(), 6u);
-    std::string header = kHeader;
-    for (const char* lobe : {"NGR", "NGTT", "NGTRT"})
-        for (int deg = 0; deg <= 180; deg += 5)
-            for (const char* c : {"_r", "_g", "_b"})
-                header += strCat(",", lobe, "_phi", deg < 100 ? "0" : "", deg < 10 ? "0" : "", deg, c);
-    EXPECT_EQ(lines[0], header);
+    EXPECT_EQ(lines[0], csvHeader());
     std::istringstream row(lines[3]);
     std::vector<double> values;
     for (std::string cell; std::getline(row, cell, ',');)
@@ -450,17 +466,13 @@ TEST(TablesCli, WritesCsvAndUsesCache) {
     test::TempDir dir;
     const std::string common = "tables -o '" + (dir / "t.csv").string() + "' --cache-dir '" +
                                (dir / "cache").string() + "' --samples 19";
-    auto r = test::runHairvox(common + " --melanin 0.5,0.2 --alpha-r -5 --beta-r 6 --eccentricity 0.9");
+    auto r =
+        test::runHairvox(common + " --melanin 0.5,0.2 --alpha-r -5 --beta-r 6 --eccentricity 0.9");
     ASSERT_EQ(r.exitCode, 0) << r.output;
     EXPECT_NE(r.output.find("built in"), std::string::npos) << r.output;
     const std::vector<std::string> lines = csvLines(dir / "t.csv");
     ASSERT_EQ(lines.size(), 20u);
-    std::string header = kHeader;
-    for (const char* lobe : {"NGR", "NGTT", "NGTRT"})
-        for (int deg = 0; deg <= 180; deg += 5)
-            for (const char* c : {"_r", "_g", "_b"})
-                header += strCat(",", lobe, "_phi", deg < 100 ? "0" : "", deg < 10 ? "0" : "", deg, c);
-    EXPECT_EQ(lines[0], header);
+    EXPECT_EQ(lines[0], csvHeader());
     r = test::runHairvox(common + " --melanin 0.5,0.2 --alpha-r -5 --beta-r 6 --eccentricity 0.9");
     ASSERT_EQ(r.exitCode, 0) << r.output;
     EXPECT_NE(r.output.find("loaded from the cache"), std::string::npos) << r.output;
@@ -473,18 +485,19 @@ TEST(TablesCli, BadValuesExitWith2) {
     test::TempDir dir;
     const std::string out = " -o '" + (dir / "t.csv").string() + "' --cache-dir '" +
                             (dir / "cache").string() + "' --samples 7";
-    for (const char* bad : {"--eta 3", "--eta nan", "--sigma-a 1,2", "--sigma-a 1,2,-3",
-                            "--sigma-a 1,2,3 --melanin 1,1", "--melanin 1,30", "--beta-r 0.1",
-                            "--alpha-r 25", "--eccentricity 0.2", "--caustic-width 0",
-                            "--caustic-gain 11", "--caustic-fade 2", "--caustic-max-width 0",
-                            "--samples 2", "--d-b 2", "--eta abc"}) {
+    for (const char* bad :
+         {"--eta 3", "--eta nan", "--sigma-a 1,2", "--sigma-a 1,2,-3",
+          "--sigma-a 1,2,3 --melanin 1,1", "--melanin 1,30", "--beta-r 0.1", "--alpha-r 25",
+          "--eccentricity 0.2", "--caustic-width 0", "--caustic-gain 11", "--caustic-fade 2",
+          "--caustic-max-width 0", "--samples 2", "--d-b 2", "--eta abc"}) {
         const auto r = test::runHairvox(std::string("tables") + out + " " + bad);
         EXPECT_EQ(r.exitCode, 2) << bad << ": " << r.output;
     }
     EXPECT_EQ(test::runHairvox("tables --samples 7").exitCode, 2); // -o is required
     EXPECT_FALSE(std::filesystem::exists(dir / "t.csv"));
     const auto r = test::runHairvox("tables --eta 3" + out);
-    EXPECT_NE(r.output.find("eta = 3 should be in the range [1.1, 2.5]"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("eta = 3 should be in the range [1.1, 2.5]"), std::string::npos)
+        << r.output;
     EXPECT_EQ(test::runHairvox("tables --help").exitCode, 0);
 }
 

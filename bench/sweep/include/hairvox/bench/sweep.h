@@ -23,9 +23,11 @@
 // The image reference uses `referenceRays` rays per shading point (exact mode
 // costs K Embree rays per point: 1–16 is affordable per frame, 256 is not)
 // spread over a disk of one default voxel h0, the scene's grid voxel size
-// (its grid.voxel_size, else defaultVoxelSize(groom)). Exact configurations of
-// the sweep use the same footprint with fewer rays; their error is the noise
-// of K rays. Voxel sizes are given as multiples of h0.
+// (its grid.voxel_size, else defaultVoxelSize(groom)), rendered as two
+// independent halves of K/2 rays (seeds 1 and 2): their mean is the reference
+// and half A's difference from it its noise, which film/image_compare.h
+// removes from every image error. Exact configurations of the sweep use the
+// same footprint with fewer rays. Voxel sizes are given as multiples of h0.
 //
 // Scaling sweep: grid mode at the default voxel size, fragment shading, over
 // scenes of increasing segment count and increasing image size, with the
