@@ -180,8 +180,9 @@ void BM_PathTrace512(benchmark::State& state) {
     pts.lights = f.scene.lights;
     pts.camera = f.scene.camera;
     pts.camera.width = pts.camera.height = 512;
-    if (f.scene.head)
-        pts.spheres.push_back({f.scene.head->sphere, f.scene.head->albedo});
+    const SceneSurfaces surfaces = loadSurfaces(f.scene);
+    pts.surfaces = surfaces.scene;
+    pts.surfaceAlbedo = surfaces.albedo;
     pts.background = f.scene.background;
     PathTraceSettings settings;
     settings.spp = 4;

@@ -90,6 +90,7 @@ Scene SceneInput::resolve() const {
         scene = defaultScene();
         scene.name = groomFile;
         scene.head.reset();
+        scene.meshes.clear(); // the default mannequin belongs to the default groom
         scene.fiberScale = FiberScale{};
         scene.groom.file = groomFile;
         scene.fiber = fiber.apply(scene.fiber);

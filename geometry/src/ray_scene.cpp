@@ -1,3 +1,5 @@
+#include "embree_check.h"
+
 #include <hairvox/core/error.h>
 #include <hairvox/geometry/ray_scene.h>
 
@@ -13,14 +15,6 @@
 namespace hairvox {
 
 namespace {
-
-/// Embree has no exceptions: check the device's error state after each call
-/// that can fail and turn it into one.
-void checkEmbree(RTCDevice device, const char* what) {
-    const RTCError error = rtcGetDeviceError(device);
-    if (error != RTC_ERROR_NONE)
-        throw std::runtime_error(strCat("Embree error ", static_cast<int>(error), " in ", what));
-}
 
 struct RawHit {
     float t;
@@ -159,11 +153,12 @@ struct RayScene::Impl {
     }
 };
 
-RayScene::RayScene(const Groom& groom, const FiberScale& scale, std::vector<Sphere> spheres)
+RayScene::RayScene(const Groom& groom, const FiberScale& scale,
+                   std::shared_ptr<const SurfaceScene> surfaces)
     : impl_(std::make_unique<Impl>())
     , width_(scale.ribbonWidth())
     , locateDistance_(std::max(1.0f, scale.densityMultiplier) * scale.diameter)
-    , spheres_(std::move(spheres)) {
+    , surfaces_(std::move(surfaces)) {
     Impl& m = *impl_;
     const float radius = 0.5f * width_;
     m.points = groom.points;
@@ -297,20 +292,6 @@ RTCRay makeRay(const Vec3f& origin, const Vec3f& dir, float tMax) {
     return ray;
 }
 
-/// The nearest sphere hit before tMax, or tMax.
-float nearestSphere(const std::vector<Sphere>& spheres, const Vec3f& o, const Vec3f& d, float tMax,
-                    std::uint32_t& which) {
-    float nearest = tMax;
-    for (std::size_t i = 0; i < spheres.size(); ++i) {
-        const float t = spheres[i].intersect(o, d, nearest);
-        if (t > 0 && t < nearest) {
-            nearest = t;
-            which = static_cast<std::uint32_t>(i);
-        }
-    }
-    return nearest;
-}
-
 } // namespace
 
 void RayScene::filterHits(const RTCFilterFunctionNArguments* args) {
@@ -344,8 +325,9 @@ void RayScene::filterHits(const RTCFilterFunctionNArguments* args) {
 std::optional<RayHit> RayScene::intersect(const Vec3f& origin, const Vec3f& dir, float tMax,
                                           const RayOrigin* from) const {
     const Impl& m = *impl_;
-    std::uint32_t sphere = 0;
-    const float tSphere = nearestSphere(spheres_, origin, dir, tMax, sphere);
+    const std::optional<SurfaceHit> surface =
+        surfaces_ ? surfaces_->intersect(origin, dir, tMax) : std::nullopt;
+    const float tSurface = surface ? surface->t : tMax;
     RayHit hit;
     if (!m.pieceStart.empty()) {
         FilterContext context{};
@@ -354,7 +336,7 @@ std::optional<RayHit> RayScene::intersect(const Vec3f& origin, const Vec3f& dir,
         context.scene = this;
         context.from = from;
         RTCRayHit rayHit{};
-        rayHit.ray = makeRay(origin, dir, tSphere);
+        rayHit.ray = makeRay(origin, dir, tSurface);
         rayHit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         rtcIntersect1(m.scene, &context.context, &rayHit);
         if (rayHit.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
@@ -367,12 +349,13 @@ std::optional<RayHit> RayScene::intersect(const Vec3f& origin, const Vec3f& dir,
             return hit;
         }
     }
-    if (!(tSphere < tMax))
+    if (!surface)
         return std::nullopt;
     hit.kind = RayHit::Kind::Surface;
-    hit.t = tSphere;
-    hit.surface = sphere;
-    hit.normal = normalizeOr(origin + tSphere * dir - spheres_[sphere].center, -dir);
+    hit.t = surface->t;
+    hit.surface = surface->surface;
+    hit.normal = surface->normal;
+    hit.geometricNormal = surface->geometricNormal;
     return hit;
 }
 
@@ -394,10 +377,7 @@ bool RayScene::occluded(const Vec3f& origin, const Vec3f& dir, float tMax,
 }
 
 bool RayScene::surfaceOccluded(const Vec3f& origin, const Vec3f& dir, float tMax) const {
-    for (const Sphere& s : spheres_)
-        if (s.intersects(origin, dir, tMax))
-            return true;
-    return false;
+    return surfaces_ && surfaces_->occluded(origin, dir, tMax);
 }
 
 std::optional<FiberPoint> RayScene::locate(const Vec3f& p, std::uint32_t strandHint) const {

@@ -62,7 +62,7 @@ enum Slot : std::size_t {
     kDirectTT = 8,    // RGB
     kDirectTRT = 11,  // RGB
     kMultiple = 14,   // RGB
-    kHead = 17,       // RGB
+    kSurface = 17,    // RGB
     kBackground = 20, // RGB
     kSlots = 23,
 };
@@ -81,7 +81,7 @@ constexpr std::array<LayerSlot, 9> kLayers{{
     {"direct_TT", kDirectTT, 3},
     {"direct_TRT", kDirectTRT, 3},
     {"multiple", kMultiple, 3},
-    {"head", kHead, 3},
+    {"surface", kSurface, 3},
     {"background", kBackground, 3},
 }};
 constexpr const char* kHalfLayer = "half_a";
@@ -123,17 +123,11 @@ Vec3f cosineDirection(const Vec3f& n, float u1, float u2) {
                           std::sqrt(std::max(0.0f, 1.0f - u1)) * n);
 }
 
-/// A surface point's ray offset: off the surface by a small multiple of the
-/// coordinates' magnitude (float resolution there).
-float surfaceOffset(const Vec3f& x) {
-    return 1e-5f * (1.0f + std::max({std::abs(x.x), std::abs(x.y), std::abs(x.z)}));
-}
-
 class Tracer {
 public:
     Tracer(const PathTraceScene& scene, const PathTraceSettings& settings)
         : scene_(scene), settings_(settings), camera_(scene.camera), bcsdf_(scene.fiber),
-          rays_(*scene.groom, scene.fiberScale, spheresOf(scene)),
+          rays_(*scene.groom, scene.fiberScale, scene.surfaces),
           slack_(2.0f * scene.fiberScale.ribbonWidth()) {
         for (const Light& l : scene.lights)
             if (!l.isDark())
@@ -183,8 +177,8 @@ public:
                 out.v[kHairAlpha] = firstOnHair ? 1.0f : 0.0f;
             }
             // Where this vertex's light goes: depth 1 on hair by lobe, deeper
-            // paths on hair to `multiple`, paths that began on a surface to `head`.
-            const std::size_t deeper = firstOnHair ? kMultiple : kHead;
+            // paths on hair to `multiple`, paths that began on a surface to `surface`.
+            const std::size_t deeper = firstOnHair ? kMultiple : kSurface;
             ++events;
             ++counters.events;
             if (hit->kind == RayHit::Kind::Fiber) {
@@ -219,25 +213,28 @@ public:
                 dir = s.wi;
                 from = here;
             } else {
-                const LambertianSphere& surface = scene_.spheres[hit->surface];
-                Vec3f n = hit->normal;
-                if (glm::dot(n, wo) < 0)
-                    n = -n;
-                const Vec3f xOff = xHit + surfaceOffset(xHit) * n;
-                const Rgb brdf = float(InvPi) * surface.albedo;
+                // Two-sided: both normals face wo (SurfaceHit); light and
+                // continuation stay on the geometric normal's side.
+                const Rgb albedo = scene_.surfaceAlbedo[hit->surface];
+                const Vec3f& n = hit->normal;
+                const Vec3f& ng = hit->geometricNormal;
+                const Vec3f xOff = xHit + surfaceOffset(xHit) * ng;
+                const Rgb brdf = float(InvPi) * albedo;
                 for (const Light& light : lights_) {
                     const Light::Path path = light.pathFrom(xOff);
                     const float cosTheta = glm::dot(n, path.omega);
-                    if (!(cosTheta > 0) || !(path.distance > 0))
+                    if (!(cosTheta > 0) || !(glm::dot(ng, path.omega) > 0) || !(path.distance > 0))
                         continue;
                     ++counters.shadowRays;
                     if (rays_.occluded(xOff, path.omega, path.distance))
                         continue;
                     out.add(deeper, throughput * brdf * light.irradiance(path.distance) * cosTheta);
                 }
-                throughput *= surface.albedo;
+                throughput *= albedo;
                 origin = xOff;
                 dir = cosineDirection(n, rng.uniformFloat(), rng.uniformFloat());
+                if (!(glm::dot(dir, ng) > 0))
+                    break; // below the surface: the shading normal's lobe dips under it
                 from.reset();
             }
             if (throughput.isBlack())
@@ -255,7 +252,7 @@ public:
             }
         }
         counters.deepest = std::max(counters.deepest, events);
-        const Rgb beauty = out.rgb(kBackground) + out.rgb(kHead) + out.hair();
+        const Rgb beauty = out.rgb(kBackground) + out.rgb(kSurface) + out.hair();
         out.add(kBeauty, beauty);
         return out;
     }
@@ -263,13 +260,6 @@ public:
     const Camera& camera() const { return camera_; }
 
 private:
-    static std::vector<Sphere> spheresOf(const PathTraceScene& scene) {
-        std::vector<Sphere> spheres;
-        for (const LambertianSphere& s : scene.spheres)
-            spheres.push_back(s.sphere);
-        return spheres;
-    }
-
     const PathTraceScene& scene_;
     const PathTraceSettings& settings_;
     Camera camera_;
@@ -343,6 +333,8 @@ PathTraceOutput pathTrace(const PathTraceScene& scene, const PathTraceSettings& 
     settings.validate();
     if (!scene.groom)
         throw std::invalid_argument("pathTrace: no groom");
+    if (scene.surfaceAlbedo.size() != (scene.surfaces ? scene.surfaces->surfaceCount() : 0))
+        throw std::invalid_argument("pathTrace: one albedo per surface is needed");
     scene.fiberScale.validate();
     const ThreadLimit threadLimit(settings.threads);
     const Tracer tracer(scene, settings);

@@ -46,6 +46,7 @@ public:
     bool present() const { return value_ != nullptr; }
     bool isNull() const { return value_ != nullptr && value_->is_null(); }
     bool isString() const { return value_ != nullptr && value_->is_string(); }
+    bool isNumber() const { return value_ != nullptr && value_->is_number(); }
     const std::string& path() const { return path_; }
 
     /// "<source>: <path>: expected <what>, got <value>".

@@ -44,17 +44,26 @@ std::string vecText(const Vec3f& v) {
 }
 
 /// Warnings about lights that cannot light anything, by name.
-void warnAboutLights(const Scene& scene, std::vector<std::string>& warnings) {
+void warnAboutLights(const Scene& scene, const SceneSurfaces& surfaces,
+                     std::vector<std::string>& warnings) {
     for (const Light& light : scene.lights) {
-        if (light.isDark())
+        if (light.isDark()) {
             warnings.push_back(strCat("light '", light.name, "' has zero intensity or colour; ",
                                       "it lights nothing and is skipped"));
-        else if (scene.head && light.kind == Light::Kind::Point &&
-                 scene.head->sphere.contains(light.position))
+        } else if (light.kind == Light::Kind::Point && scene.head &&
+                   scene.head->sphere.contains(light.position)) {
             warnings.push_back(strCat(
                 "light '", light.name, "' at ", vecText(light.position),
                 " is inside the head (center ", vecText(scene.head->sphere.center), ", radius ",
                 scene.head->sphere.radius, "); it lights nothing and is skipped"));
+        } else if (light.kind == Light::Kind::Point && surfaces.scene &&
+                   surfaces.scene->contains(light.position)) {
+            warnings.push_back(strCat("light '", light.name, "' at ", vecText(light.position),
+                                      " is inside a mesh (bounds ",
+                                      vecText(surfaces.scene->bounds().min), " to ",
+                                      vecText(surfaces.scene->bounds().max),
+                                      "); it lights nothing and is skipped"));
+        }
     }
 }
 
@@ -106,8 +115,10 @@ MemoryEstimate estimateRenderMemory(const Scene& scene) {
         // hair.A 1, depth 1; per light V 1, n 1, T_s 3, sigma_f 3.
         m.filmChannels = 27 + 8 * static_cast<int>(scene.lights.size());
         perPixel += std::uint64_t(m.filmChannels) * 4;
-        if (scene.head)
-            perPixel += 5 * 4; // the head's surface layer: coverage, depth, radiance
+        if (scene.head || !scene.meshes.empty())
+            // The surface layer (coverage, depth, radiance), the corner rays'
+            // hits and the points to shade with their radiance.
+            perPixel += 5 * 4 + 8 + 56 + 12;
     }
     m.film = pixels * perPixel;
     // Per point: the point, its tangent and projection in the rasterizer, the
@@ -143,12 +154,42 @@ void checkVoxelSizeForGroom(const Scene& scene, const Groom& groom) {
                    kDefaultVoxelsAcross, " = ", longest / float(kDefaultVoxelsAcross), ")"));
 }
 
-GlobalTermSettings globalTermSettings(const Scene& scene) {
+SceneSurfaces loadSurfaces(const Scene& scene) {
+    SceneSurfaces out;
+    std::vector<Sphere> spheres;
+    if (scene.head) {
+        spheres.push_back(scene.head->sphere);
+        out.albedo.push_back(scene.head->albedo);
+    }
+    std::vector<TriangleMesh> meshes;
+    for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
+        const MeshSource& source = scene.meshes[i];
+        try {
+            if (source.isMannequin()) {
+                meshes.push_back(generateHeadMesh(source.mannequin));
+            } else {
+                LoadedMesh loaded = readObjMesh(source.file);
+                meshes.push_back(std::move(loaded.mesh));
+                for (std::string& w : loaded.warnings)
+                    out.warnings.push_back(std::move(w));
+            }
+        } catch (const InputError& e) {
+            throw InputError(strCat(scene.name, ": meshes[", i, "]: ", e.what()));
+        }
+        source.transform.apply(meshes.back());
+        out.albedo.push_back(source.albedo);
+        throwIfInterrupted();
+    }
+    if (!spheres.empty() || !meshes.empty())
+        out.scene = std::make_shared<const SurfaceScene>(std::move(spheres), std::move(meshes));
+    return out;
+}
+
+GlobalTermSettings globalTermSettings(const Scene& scene, const SceneSurfaces& surfaces) {
     GlobalTermSettings s;
     s.fiberScale = scene.fiberScale;
     s.dualScattering = scene.dualScattering;
-    if (scene.head)
-        s.occluder = scene.head->sphere;
+    s.surfaces = surfaces.scene;
     return s;
 }
 
@@ -182,6 +223,7 @@ std::unique_ptr<SceneAssets> loadSceneAssets(const Scene& scene, const PipelineO
     auto assets = std::make_unique<SceneAssets>();
     auto start = Clock::now();
     assets->groom = loadGroom(scene, assets->groomWarnings);
+    assets->surfaces = loadSurfaces(scene);
     assets->times.load = secondsSince(start);
     throwIfInterrupted();
 
@@ -215,7 +257,7 @@ std::unique_ptr<SceneAssets> loadSceneAssets(const Scene& scene, const PipelineO
 
     start = Clock::now();
     const CrossingTable crossings = CrossingTable::fromDualScattering(*assets->tables);
-    const GlobalTermSettings settings = globalTermSettings(scene);
+    const GlobalTermSettings settings = globalTermSettings(scene, assets->surfaces);
     switch (scene.globalTermMode) {
     case GlobalTermMode::Exact: {
         ExactOptions exact;
@@ -270,20 +312,30 @@ SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& opti
         terms.push_back(std::move(term));
     }
 
+    // The surfaces as the camera sees them, lit through the hair.
+    const Camera camera(scene.camera);
+    const auto surfacesStart = Clock::now();
+    SurfaceLayer surfaces;
+    if (assets->surfaces.scene) {
+        std::vector<const LightGlobalTerm*> lightTerms;
+        for (const auto& t : terms)
+            lightTerms.push_back(t.get());
+        surfaces = detail::surfaceLayer(*assets->surfaces.scene, assets->surfaces.albedo, camera,
+                                        scene.lights, lightTerms);
+    }
+    const double surfaceSeconds = secondsSince(surfacesStart);
+
     const MarschnerBcsdf bcsdf(scene.fiber);
     const DualScatteringShader shader(bcsdf, *assets->tables, scene.dualScattering);
     const detail::DualScatteringFragmentShader fragmentShader(shader, scene.lights,
                                                               std::move(terms));
-    const Camera camera(scene.camera);
-    const auto surfacesStart = Clock::now();
-    const SurfaceLayer surfaces =
-        scene.head ? detail::headSurfaceLayer(*scene.head, camera, scene.lights) : SurfaceLayer{};
-    const double surfaceSeconds = secondsSince(surfacesStart);
     RasterOutput image =
         rasterize(assets->groom, camera, fragmentShader, rasterSettings(scene, options), surfaces);
     result.film = std::move(image.film);
     result.raster = image.stats;
-    warnAboutLights(scene, result.warnings);
+    for (const std::string& w : assets->surfaces.warnings)
+        result.warnings.push_back(w);
+    warnAboutLights(scene, assets->surfaces, result.warnings);
     for (std::string& w : image.warnings)
         result.warnings.push_back(std::move(w));
     warnIfNoHairSeen(scene, result.film, &assets->groom, result.warnings);
@@ -319,8 +371,11 @@ SceneRender renderPathTraced(const Scene& scene, const PipelineOptions& options,
     const Groom groom = loadGroom(scene, groomWarnings);
     if (!groomWarnings.empty())
         result.warnings.push_back(groomWarnings);
+    const SceneSurfaces surfaces = loadSurfaces(scene);
+    for (const std::string& w : surfaces.warnings)
+        result.warnings.push_back(w);
     result.times.load = secondsSince(start);
-    const std::string hash = pathTraceHash(scene, groom);
+    const std::string hash = pathTraceHash(scene, groom, surfaces);
 
     // Continue from the scene's own earlier output, if asked and it is there.
     std::optional<Film> previous;
@@ -354,8 +409,8 @@ SceneRender renderPathTraced(const Scene& scene, const PipelineOptions& options,
     pts.fiber = scene.fiber;
     pts.lights = scene.lights;
     pts.camera = scene.camera;
-    if (scene.head)
-        pts.spheres.push_back({scene.head->sphere, scene.head->albedo});
+    pts.surfaces = surfaces.scene;
+    pts.surfaceAlbedo = surfaces.albedo;
     pts.background = scene.background;
     PathTraceSettings settings = scene.pathTrace;
     settings.threads = options.threads;
@@ -365,7 +420,7 @@ SceneRender renderPathTraced(const Scene& scene, const PipelineOptions& options,
     result.times.trace = secondsSince(start);
     result.film = std::move(traced.film);
     result.pathTrace = traced.stats;
-    warnAboutLights(scene, result.warnings);
+    warnAboutLights(scene, surfaces, result.warnings);
     if (traced.stats.spp > 0) // an image without samples says nothing about what the camera sees
         warnIfNoHairSeen(scene, result.film, &groom, result.warnings);
     for (const Light& light : scene.lights)
@@ -426,7 +481,7 @@ ComparedImage hairRadianceOf(const Film& film) {
                                    film.find("hair_half_a") ? "hair_half_a" : std::string_view{});
 }
 
-std::string pathTraceHash(const Scene& scene, const Groom& groom) {
+std::string pathTraceHash(const Scene& scene, const Groom& groom, const SceneSurfaces& surfaces) {
     Hasher h;
     h.value(contentHash(groom));
     scene.fiberScale.hashInto(h);
@@ -442,6 +497,12 @@ std::string pathTraceHash(const Scene& scene, const Groom& groom) {
         h.value(scene.head->sphere.center)
             .value(scene.head->sphere.radius)
             .value(scene.head->albedo);
+    h.value(surfaces.albedo.size());
+    for (const Rgb& a : surfaces.albedo)
+        h.value(a);
+    if (surfaces.scene)
+        for (const TriangleMesh& m : surfaces.scene->meshes())
+            h.value(m.contentHash());
     h.value(scene.background);
     h.value(scene.pathTrace.seed)
         .value(scene.pathTrace.maxDepth)
@@ -560,18 +621,18 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
     std::uint64_t queries = 0, blocked = 0, empty = 0, skippedLights = 0;
     for (const LightReport& l : r.lights) {
         queries += l.stats.queries;
-        blocked += l.stats.blockedByOccluder;
+        blocked += l.stats.blockedBySurface;
         empty += l.stats.emptyPaths;
         skippedLights += l.skipped ? 1 : 0;
     }
     row("global term", r.times.globalTerm,
         thousands(queries) + " queries; skipped: " + thousands(skippedLights) + " light(s), " +
-            thousands(blocked) + " behind the head, " + thousands(empty) +
+            thousands(blocked) + " behind surfaces, " + thousands(empty) +
             " with nothing in front");
     row("raster", r.times.raster,
         thousands(st.fragments) + " fragments; skipped: " + thousands(st.segmentsOutsideView) +
             " segments outside the view, " + thousands(st.segmentTilesBehindSurfaces) +
-            " segment-tiles behind the head, " + thousands(st.segmentTilesSkipped) +
+            " segment-tiles behind surfaces, " + thousands(st.segmentTilesSkipped) +
             " segment-tiles opaque");
     row("shade", r.times.shade,
         thousands(st.shadingPoints) + " shading points; skipped " +

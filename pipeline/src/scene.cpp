@@ -33,6 +33,7 @@ constexpr Range kExposure{-20.0, 20.0};
 constexpr Range kTimeLimit{0.0, 1e7};
 constexpr Range kDegrees{-360.0, 360.0};
 constexpr Range kAny{-1e30, 1e30};
+constexpr Range kMeshScale{-1e6, 1e6};
 constexpr std::size_t kMaxLightNameLength = 32;
 constexpr std::uintmax_t kMaxSceneFileBytes = 16u << 20;
 
@@ -256,6 +257,49 @@ Head parseHead(JsonObject obj) {
     return h;
 }
 
+MeshTransform parseMeshTransform(JsonObject obj) {
+    MeshTransform t;
+    if (const JsonValue v = obj["scale"]; v.present()) {
+        t.scale = v.isNumber() ? Vec3f(v.numberF(kMeshScale)) : v.vec3(kMeshScale);
+        if (t.scale.x * t.scale.y * t.scale.z == 0.0f)
+            v.failExpected("a non-zero scale (a number or 3 numbers)");
+    }
+    if (const JsonValue v = obj["rotate"]; v.present())
+        t.rotateDegrees = v.vec3(kDegrees);
+    if (const JsonValue v = obj["translate"]; v.present())
+        t.translate = v.vec3(kCoordinate);
+    obj.finish();
+    return t;
+}
+
+MeshSource parseMesh(JsonObject obj, const std::filesystem::path& baseDir) {
+    MeshSource m;
+    const JsonValue file = obj["file"];
+    const JsonValue mannequin = obj["mannequin"];
+    if (file.present() == mannequin.present())
+        obj.fail("expected exactly one of \"file\" (an OBJ mesh) and \"mannequin\" (a generated head)");
+    if (file.present()) {
+        const std::string name = file.string();
+        if (name.empty())
+            file.failExpected("a non-empty path");
+        const std::filesystem::path path(name);
+        m.file = path.is_absolute() ? path : baseDir / path;
+    } else {
+        JsonObject head = mannequin.object();
+        if (const JsonValue v = head["center"]; v.present())
+            m.mannequin.center = v.vec3(kCoordinate);
+        if (const JsonValue v = head["radius"]; v.present())
+            m.mannequin.radius = v.numberF(kHeadRadius);
+        head.finish();
+    }
+    if (const JsonValue v = obj["transform"]; v.present())
+        m.transform = parseMeshTransform(v.object());
+    if (const JsonValue v = obj["color"]; v.present())
+        m.albedo = v.rgb(kAlbedo);
+    obj.finish();
+    return m;
+}
+
 std::filesystem::path parseOutputPath(const JsonValue& v, const std::filesystem::path& fallback) {
     if (!v.present())
         return fallback;
@@ -324,6 +368,22 @@ void Scene::validate() const {
         if (glm::distance(camera.position, head->sphere.center) <= head->sphere.radius)
             throw InputError("camera.position is inside the head sphere");
     }
+    if (meshes.size() > kMaxMeshes)
+        throw InputError(strCat(meshes.size(), " meshes: expected at most ", kMaxMeshes));
+    for (std::size_t i = 0; i < meshes.size(); ++i) {
+        const MeshSource& m = meshes[i];
+        const std::string field = strCat("meshes[", i, "]");
+        if (m.isMannequin()) {
+            requireInRange(field + ".mannequin.center", m.mannequin.center, kCoordinate);
+            requireInRange(field + ".mannequin.radius", m.mannequin.radius, kHeadRadius);
+        }
+        requireInRange(field + ".transform.scale", m.transform.scale, kMeshScale);
+        if (m.transform.scale.x * m.transform.scale.y * m.transform.scale.z == 0.0f)
+            throw InputError(strCat(field, ".transform.scale: expected non-zero components"));
+        requireInRange(field + ".transform.rotate", m.transform.rotateDegrees, kDegrees);
+        requireInRange(field + ".transform.translate", m.transform.translate, kCoordinate);
+        requireInRange(field + ".color", m.albedo, kAlbedo);
+    }
     if (voxelSize)
         requireInRange("grid.voxel_size", *voxelSize, kVoxelSize);
     if (exact.rays < 1 || exact.rays > kMaxExactRays)
@@ -369,6 +429,9 @@ Scene parseScene(const nlohmann::json& document, const std::string& sourceName,
     scene.camera = parseCamera(root.required("camera", "an object").object());
     if (const JsonValue v = root["head"]; v.present() && !v.isNull())
         scene.head = parseHead(v.object());
+    if (const JsonValue v = root["meshes"]; v.present())
+        for (const JsonValue& m : v.array(0, kMaxMeshes))
+            scene.meshes.push_back(parseMesh(m.object(), baseDir));
 
     if (const JsonValue v = root["grid"]; v.present()) {
         JsonObject grid = v.object();
@@ -493,6 +556,13 @@ std::ostream& operator<<(std::ostream& os, const Scene& s) {
     if (s.head)
         os << ", head(center=" << s.head->sphere.center << ", r=" << s.head->sphere.radius
            << ", albedo=" << s.head->albedo << ")";
+    for (const MeshSource& m : s.meshes) {
+        if (m.isMannequin())
+            os << ", mesh(mannequin center=" << m.mannequin.center << ", r=" << m.mannequin.radius;
+        else
+            os << ", mesh(" << m.file.string();
+        os << ", albedo=" << m.albedo << ")";
+    }
     os << ", mode=" << s.globalTermMode
        << ", voxel=" << (s.voxelSize ? strCat(*s.voxelSize) : std::string("auto"))
        << ", exact(rays=" << s.exact.rays << ", r=" << s.exact.radius << "), rate=" << s.shadingRate

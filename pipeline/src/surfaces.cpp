@@ -1,115 +1,203 @@
 #include "surfaces.h"
 
+#include <hairvox/core/interrupt.h>
 #include <hairvox/core/math.h>
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 
 namespace hairvox::detail {
 
 namespace {
 
-constexpr int kSilhouetteSamples = 8; ///< per side, on the head's silhouette
+constexpr int kEdgeSamples = 8;          ///< per side, in a silhouette or depth-edge pixel
+constexpr int kQuadrant = kEdgeSamples / 2;
+constexpr float kSmoothDepthRatio = 1.02f; ///< corners this close in depth: one smooth surface
+constexpr std::uint32_t kMiss = std::numeric_limits<std::uint32_t>::max();
 
-/// The head seen from the camera: which pixels it covers, its depth and its
-/// Lambertian radiance.
-class HeadView {
-public:
-    HeadView(const Head& head, const Camera& camera, const std::vector<Light>& lights)
-        : head_(head)
-        , camera_(camera)
-        , lights_(lights) {
-        const Vec3f center = camera.directionToCamera(head.sphere.center - camera.position());
-        axis_ = glm::normalize(center);
-        // A pixel spans at most 1/f radians, so pixel centres farther than that
-        // from the silhouette cone are wholly inside or outside it.
-        const float psi = safeASin(head.sphere.radius / glm::length(center));
-        const float pixel = 1.0f / camera.focalLength();
-        cosInner_ = std::cos(std::max(psi - pixel, 0.0f));
-        cosOuter_ = std::cos(std::min(psi + pixel, float(Pi)));
+/// Where the camera ray through a raster position meets the surfaces.
+struct ViewSample {
+    std::uint32_t surface = kMiss;
+    float depth = 0;         ///< camera-space z
+    Vec3f position{0.0f};
+    Vec3f normal{0.0f};      ///< shading, facing the camera
+    Vec3f geometricNormal{0.0f};
+};
+
+ViewSample castView(const SurfaceScene& surfaces, const Camera& camera, const Vec2f& raster) {
+    const Vec3f dirCam = camera.rayDirection(raster);
+    const Vec3f dir = camera.toWorldDirection(dirCam);
+    // Geometry nearer than the near plane is clipped, as for the hair.
+    const float tNear = camera.nearClip() / dirCam.z;
+    const Vec3f origin = camera.position() + tNear * dir;
+    ViewSample s;
+    if (const std::optional<SurfaceHit> hit =
+            surfaces.intersect(origin, dir, std::numeric_limits<float>::infinity())) {
+        s.surface = hit->surface;
+        s.depth = (tNear + hit->t) * dirCam.z;
+        s.position = origin + hit->t * dir;
+        s.normal = hit->normal;
+        s.geometricNormal = hit->geometricNormal;
     }
+    return s;
+}
 
-    /// Coverage, mean depth and mean radiance of the head in pixel (x, y).
-    bool cover(int x, int y, float& coverage, float& depth, Rgb& radiance) const {
-        const Vec2f centre(float(x) + 0.5f, float(y) + 0.5f);
-        const float cosPsi = glm::dot(camera_.rayDirection(centre), axis_);
-        if (cosPsi <= cosOuter_)
-            return false;
-        if (cosPsi >= cosInner_) {
-            coverage = 1.0f;
-            return sample(centre, depth, radiance);
-        }
-        int hits = 0;
-        double depthSum = 0;
-        Rgb radianceSum(0.0f);
-        for (int j = 0; j < kSilhouetteSamples; ++j)
-            for (int i = 0; i < kSilhouetteSamples; ++i) {
-                const Vec2f p(float(x) + (float(i) + 0.5f) / kSilhouetteSamples,
-                              float(y) + (float(j) + 0.5f) / kSilhouetteSamples);
-                float z;
-                Rgb l;
-                if (sample(p, z, l)) {
-                    ++hits;
-                    depthSum += double(z);
-                    radianceSum += l;
-                }
-            }
-        if (hits == 0)
-            return false;
-        coverage = float(hits) / float(kSilhouetteSamples * kSilhouetteSamples);
-        depth = static_cast<float>(depthSum / hits);
-        radiance = radianceSum / float(hits);
-        return true;
-    }
+/// What a pixel-corner ray met (8 bytes: one per pixel of the image).
+struct CornerHit {
+    std::uint32_t surface = kMiss;
+    float depth = 0;
+};
 
-private:
-    bool sample(const Vec2f& raster, float& depth, Rgb& radiance) const {
-        const Vec3f dirCam = camera_.rayDirection(raster);
-        const Vec3f dir = camera_.toWorldDirection(dirCam);
-        const float t =
-            head_.sphere.intersect(camera_.position(), dir, std::numeric_limits<float>::infinity());
-        if (!(t > 0))
-            return false; // missed, or the head is behind the camera
-        depth = t * dirCam.z;
-        const Vec3f x = camera_.position() + t * dir;
-        const Vec3f normal = normalizeOr(x - head_.sphere.center, -dir);
-        Rgb irradiance(0.0f);
-        for (const Light& light : lights_) {
-            const Light::Path path = light.pathFrom(x);
-            const float cosTheta = glm::dot(normal, path.omega);
-            if (cosTheta > 0)
-                irradiance += cosTheta * light.irradiance(path.distance);
-        }
-        radiance = float(InvPi) * head_.albedo * irradiance;
-        return true;
-    }
-
-    const Head& head_;
-    const Camera& camera_;
-    const std::vector<Light>& lights_;
-    Vec3f axis_;
-    float cosInner_, cosOuter_;
+/// A point to shade and the share of its pixel's surface radiance it stands for.
+struct ShadingSample {
+    std::size_t pixel;
+    float weight;
+    ViewSample view;
 };
 
 } // namespace
 
-SurfaceLayer headSurfaceLayer(const Head& head, const Camera& camera,
-                              const std::vector<Light>& lights) {
-    const HeadView view(head, camera, lights);
-    const std::size_t pixels = std::size_t(camera.width()) * std::size_t(camera.height());
+SurfaceLayer surfaceLayer(const SurfaceScene& surfaces, const std::vector<Rgb>& albedo,
+                          const Camera& camera, const std::vector<Light>& lights,
+                          const std::vector<const LightGlobalTerm*>& terms) {
+    const int width = camera.width(), height = camera.height();
+    const std::size_t pixels = std::size_t(width) * std::size_t(height);
     SurfaceLayer layer;
     layer.coverage.assign(pixels, 0.0f);
     layer.depth.assign(pixels, 0.0f);
     layer.radiance.assign(pixels, Rgb(0.0f));
-    tbb::parallel_for(0, camera.height(), [&](int y) {
-        for (int x = 0; x < camera.width(); ++x) {
-            const std::size_t p = std::size_t(y) * std::size_t(camera.width()) + std::size_t(x);
-            if (!view.cover(x, y, layer.coverage[p], layer.depth[p], layer.radiance[p]))
-                layer.coverage[p] = 0.0f;
+    if (surfaces.empty())
+        return layer;
+
+    // 1. Visibility at the pixel corners.
+    const std::size_t cornerRow = std::size_t(width) + 1;
+    std::vector<CornerHit> corners(cornerRow * (std::size_t(height) + 1));
+    tbb::parallel_for(0, height + 1, [&](int y) {
+        for (int x = 0; x <= width; ++x) {
+            const ViewSample s = castView(surfaces, camera, Vec2f(float(x), float(y)));
+            corners[std::size_t(y) * cornerRow + std::size_t(x)] = {s.surface, s.depth};
         }
     });
+    throwIfInterrupted();
+
+    // 2. Coverage and depth per pixel; the points to shade, per row (in pixel order).
+    std::vector<std::vector<ShadingSample>> rows(static_cast<std::size_t>(height));
+    tbb::parallel_for(0, height, [&](int y) {
+        std::vector<ShadingSample>& out = rows[std::size_t(y)];
+        for (int x = 0; x < width; ++x) {
+            const std::size_t p = std::size_t(y) * std::size_t(width) + std::size_t(x);
+            const CornerHit* c[4] = {&corners[std::size_t(y) * cornerRow + std::size_t(x)],
+                                      &corners[std::size_t(y) * cornerRow + std::size_t(x) + 1],
+                                      &corners[std::size_t(y + 1) * cornerRow + std::size_t(x)],
+                                      &corners[std::size_t(y + 1) * cornerRow + std::size_t(x) + 1]};
+            int hits = 0;
+            bool sameSurface = true;
+            float zMin = std::numeric_limits<float>::infinity(), zMax = 0;
+            for (const CornerHit* s : c) {
+                if (s->surface == kMiss)
+                    continue;
+                ++hits;
+                sameSurface = sameSurface && s->surface == c[0]->surface;
+                zMin = std::min(zMin, s->depth);
+                zMax = std::max(zMax, s->depth);
+            }
+            if (hits == 0)
+                continue;
+            if (hits == 4 && sameSurface && zMax <= kSmoothDepthRatio * zMin) {
+                const ViewSample centre =
+                    castView(surfaces, camera, Vec2f(float(x) + 0.5f, float(y) + 0.5f));
+                if (centre.surface == c[0]->surface) {
+                    layer.coverage[p] = 1.0f;
+                    layer.depth[p] = centre.depth;
+                    out.push_back({p, 1.0f, centre});
+                    continue;
+                }
+            }
+            // A silhouette or a depth edge: 8×8 samples, one shaded per quadrant.
+            int covered = 0;
+            double depthSum = 0;
+            const std::size_t firstShaded = out.size();
+            for (int qy = 0; qy < 2; ++qy)
+                for (int qx = 0; qx < 2; ++qx) {
+                    int quadrantHits = 0;
+                    ViewSample shaded;
+                    for (int j = qy * kQuadrant; j < (qy + 1) * kQuadrant; ++j)
+                        for (int i = qx * kQuadrant; i < (qx + 1) * kQuadrant; ++i) {
+                            const ViewSample s = castView(
+                                surfaces, camera,
+                                Vec2f(float(x) + (float(i) + 0.5f) / kEdgeSamples,
+                                      float(y) + (float(j) + 0.5f) / kEdgeSamples));
+                            if (s.surface == kMiss)
+                                continue;
+                            if (quadrantHits++ == 0)
+                                shaded = s;
+                            depthSum += double(s.depth);
+                        }
+                    covered += quadrantHits;
+                    if (quadrantHits > 0)
+                        out.push_back({p, float(quadrantHits), shaded});
+                }
+            if (covered == 0)
+                continue;
+            layer.coverage[p] = float(covered) / float(kEdgeSamples * kEdgeSamples);
+            layer.depth[p] = static_cast<float>(depthSum / covered);
+            for (std::size_t k = firstShaded; k < out.size(); ++k)
+                out[k].weight /= float(covered);
+        }
+    });
+    throwIfInterrupted();
+    std::vector<ShadingSample> samples;
+    for (std::vector<ShadingSample>& row : rows) {
+        samples.insert(samples.end(), row.begin(), row.end());
+        row = {};
+    }
+
+    // 3. Lambertian radiance lit through the hair, light by light.
+    std::vector<Rgb> radiance(samples.size(), Rgb(0.0f));
+    constexpr std::size_t kBatch = 1024;
+    for (std::size_t l = 0; l < lights.size(); ++l) {
+        if (!terms[l])
+            continue;
+        const Light& light = lights[l];
+        tbb::parallel_for(
+            tbb::blocked_range<std::size_t>(0, samples.size(), kBatch), [&](const auto& range) {
+                std::vector<GlobalTermQuery> queries;
+                std::vector<std::size_t> which;
+                std::vector<float> cosines;
+                for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                    const ViewSample& v = samples[i].view;
+                    const Vec3f x = v.position + surfaceOffset(v.position) * v.geometricNormal;
+                    const Light::Path path = light.pathFrom(x);
+                    const float cosTheta = glm::dot(v.normal, path.omega);
+                    if (!(cosTheta > 0) || !(glm::dot(v.geometricNormal, path.omega) > 0))
+                        continue;
+                    Vec3f across, unused;
+                    coordinateSystem(path.omega, across, unused);
+                    GlobalTermQuery q{x, across};
+                    q.onFiber = false;
+                    queries.push_back(q);
+                    which.push_back(i);
+                    cosines.push_back(cosTheta);
+                }
+                std::vector<GlobalTerm> g(queries.size());
+                terms[l]->evaluate(queries, g);
+                for (std::size_t k = 0; k < queries.size(); ++k) {
+                    const std::size_t i = which[k];
+                    const float distance = light.pathFrom(queries[k].position).distance;
+                    radiance[i] += float(InvPi) * albedo[samples[i].view.surface] *
+                                   light.irradiance(distance) * cosines[k] *
+                                   (Rgb(g[k].V) + g[k].T_s);
+                }
+            });
+        throwIfInterrupted();
+    }
+    for (std::size_t i = 0; i < samples.size(); ++i)
+        layer.radiance[samples[i].pixel] += samples[i].weight * radiance[i];
     return layer;
 }
 

@@ -2,23 +2,37 @@
 // them — the SurfaceLayer the rasterizer composites the hair with
 // (render/rasterizer.h).
 //
-// The head sphere: a pixel centre farther than one pixel's angle from the
-// silhouette cone is wholly inside or outside it; the pixels on the
-// silhouette take 8×8 samples for their coverage, mean depth and mean
-// radiance. Radiance is Lambertian, (albedo/π)·Σ E_l·cos θ_l, lit by the
-// scene's lights without shadows.
+// Visibility: one ray through every pixel corner. A pixel whose four corners
+// meet the same surface at depths within 2% of each other (and whose centre
+// does too) is wholly covered and shaded once, at its centre; any other pixel
+// with a corner on a surface is a silhouette or a depth edge and takes 8×8
+// samples for its coverage and mean depth, shaded at one sample per 4×4
+// quadrant (weighted by the quadrant's hits). A surface narrower than a pixel
+// between four corners that all miss it is not drawn.
+//
+// Radiance is Lambertian, lit through the hair:
+//     L = (ρ/π) Σ_l E_l · max(0, n·ω_l) · (V_l + T_s,l),
+// with V and T_s the light's global term at the point (transmittance/: the
+// hair's shadow — unscattered and forward-scattered light — and the other
+// surfaces' shadow, withSurfaces()), queried a surfaceOffset() off the surface
+// as a point on no fiber.
 #pragma once
 
+#include <hairvox/core/rgb.h>
 #include <hairvox/geometry/camera.h>
 #include <hairvox/geometry/light.h>
-#include <hairvox/pipeline/scene.h>
+#include <hairvox/geometry/surface_scene.h>
 #include <hairvox/render/rasterizer.h>
+#include <hairvox/transmittance/global_term_model.h>
 
 #include <vector>
 
 namespace hairvox::detail {
 
-SurfaceLayer headSurfaceLayer(const Head& head, const Camera& camera,
-                              const std::vector<Light>& lights);
+/// `terms[l]` is light l's global term, or null for a light that is skipped;
+/// `albedo` has one entry per surface.
+SurfaceLayer surfaceLayer(const SurfaceScene& surfaces, const std::vector<Rgb>& albedo,
+                          const Camera& camera, const std::vector<Light>& lights,
+                          const std::vector<const LightGlobalTerm*>& terms);
 
 } // namespace hairvox::detail

@@ -37,7 +37,7 @@ TEST(CliCommands, RenderDefaultSceneSmall) {
 TEST(CliCommands, RenderRejectsBadSceneAndOptions) {
     test::TempDir dir;
     std::string scene = readText(test::dataDir() / "scenes" / "default.json");
-    const std::string direction = "\"direction\": [-0.6, 0.65, -0.45]";
+    const std::string direction = "\"direction\": [-0.2, 0.55, 0.8]";
     ASSERT_NE(scene.find(direction), std::string::npos);
     scene.replace(scene.find(direction), direction.size(), "\"direction\": \"up\"");
     test::writeText(dir / "bad.json", scene);

@@ -130,7 +130,9 @@ struct SmallScene {
                         Light::directional(Vec3f(-0.45f, 0.3f, 0.85f))};
         scene.lights[1].name = "back";
         scene.lights[1].intensity = 2.0f;
-        scene.spheres.push_back({Sphere{Vec3f(0.0f), 0.1f}, Rgb(0.55f, 0.4f, 0.33f)});
+        scene.surfaces = std::make_shared<const SurfaceScene>(
+            std::vector<Sphere>{{Vec3f(0.0f), 0.1f}}, std::vector<TriangleMesh>{});
+        scene.surfaceAlbedo = {Rgb(0.55f, 0.4f, 0.33f)};
         scene.background = Rgb(0.05f);
     }
 };

@@ -67,7 +67,7 @@ TEST(RenderPipeline, EveryModeWritesItsLayers) {
         EXPECT_EQ(r.raster->invalidSamples, 0u) << toString(mode);
         const ExrImage exr = readExr(scene.output.exr);
         for (const char* layer : {"R", "G", "B", "A", "direct_R.R", "direct_TT.G", "direct_TRT.B",
-                                  "back_direct.R", "scatter.G", "head.R", "background.B", "hair.A",
+                                  "back_direct.R", "scatter.G", "surface.R", "background.B", "hair.A",
                                   "Z", "key.V", "key.n", "key.T_s.R", "key.sigma_f.G", "back.V"})
             EXPECT_TRUE(exr.channels.count(layer)) << toString(mode) << ": no layer " << layer;
         EXPECT_EQ(exr.attributes.at("hairvox:globalTermMode"), toString(mode));
@@ -95,6 +95,7 @@ TEST(RenderPipeline, OneFiberIsTheShaderTimesCoverageAndIrradiance) {
     groom.addStrand(line);
     writeHairFile(scene.groom.file, groom);
     scene.head.reset();
+    scene.meshes.clear();
     scene.background = Rgb(0.0f);
     scene.fiberScale = FiberScale{2e-3f, 1.0f}; // 0.3 pixel
     scene.camera.position = Vec3f(0.0f, 0.05f, 0.3f);
@@ -195,7 +196,7 @@ TEST(RenderPipeline, HeadShadowsTheHairBehindIt) {
         alpha += hairAlpha(shadowed.film, i);
     }
     EXPECT_GT(alpha, 5.0);
-    EXPECT_EQ(shadowed.lights[0].stats.blockedByOccluder, shadowed.lights[0].stats.queries);
+    EXPECT_EQ(shadowed.lights[0].stats.blockedBySurface, shadowed.lights[0].stats.queries);
     // The same light in front of the head lights them.
     scene.lights[0].direction = Vec3f(0, 0, 1);
     const SceneRender lit = renderScene(scene, options(dir), false);
@@ -208,6 +209,8 @@ TEST(RenderPipeline, HeadShadowsTheHairBehindIt) {
 TEST(RenderPipeline, HeadIsLambertianAndHidesTheHairBehindIt) {
     test::TempDir dir;
     Scene scene = smallScene(dir);
+    scene.meshes.clear(); // the analytic head sphere instead of the mannequin
+    scene.head = Head{};
     scene.groom.procedural.strands = 50;
     scene.camera.position = Vec3f(0, 0, 0.5f);
     scene.camera.lookAt = Vec3f(0, 0, 0);

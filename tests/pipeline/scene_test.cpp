@@ -324,8 +324,13 @@ TEST(Scene, DefaultSceneIsTheShowcase) {
     EXPECT_EQ(s.groom.procedural.style, GroomStyle::Wavy);
     EXPECT_GE(s.groom.procedural.strands, 15000u);
     EXPECT_LE(s.groom.procedural.strands, 25000u);
-    EXPECT_EQ(s.fiber.sigma_a, Rgb(0.12f, 0.2f, 0.4f)); // light blond (docs/scene.md)
-    ASSERT_TRUE(s.head.has_value());
+    // Light blond (docs/scene.md): eumelanin 0.12, pheomelanin 0.2.
+    EXPECT_EQ(s.fiber.sigma_a, FiberParams::sigmaFromMelanin(0.12f, 0.2f));
+    // On a mannequin head whose cranium is the groom's head sphere.
+    ASSERT_EQ(s.meshes.size(), 1u);
+    EXPECT_TRUE(s.meshes[0].isMannequin());
+    EXPECT_EQ(s.meshes[0].mannequin.center, s.groom.procedural.headCenter);
+    EXPECT_EQ(s.meshes[0].mannequin.radius, s.groom.procedural.headRadius);
     EXPECT_GE(s.lights.size(), 2u);
     EXPECT_EQ(s.camera.width, 1024u);
     EXPECT_EQ(s.camera.height, 1024u);

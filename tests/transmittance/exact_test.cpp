@@ -137,7 +137,8 @@ TEST(ExactGlobalTerm, CurlComingBackCounts) {
 TEST(ExactGlobalTerm, OccluderBlocksLight) {
     const test::Slab slab;
     GlobalTermSettings s = slabSettings();
-    s.occluder = Sphere{Vec3f(0, 0.05f, 0), 0.01f};
+    s.surfaces = std::make_shared<const SurfaceScene>(std::vector<Sphere>{{Vec3f(0, 0.05f, 0), 0.01f}},
+                                                     std::vector<TriangleMesh>{});
     const auto model = makeExactModel(slab.groom(), constantTable(0.5f, 0.01f), s, {});
     const auto light = model->forLight(Light::point(Vec3f(0, 0.1f, 0)));
     const GlobalTermQuery queries[2] = {{Vec3f(0, -0.001f, 0), Vec3f(1, 0, 0)},
@@ -147,7 +148,7 @@ TEST(ExactGlobalTerm, OccluderBlocksLight) {
     EXPECT_EQ(out[0].V, 0.0f);
     EXPECT_EQ(out[0].T_s, Rgb(0.0f));
     EXPECT_GT(out[1].n, 0.0f);
-    EXPECT_EQ(stats.blockedByOccluder, 1u);
+    EXPECT_EQ(stats.blockedBySurface, 1u);
 }
 
 TEST(ExactGlobalTerm, IndependentOfBatchingAndOrder) {
@@ -180,12 +181,13 @@ namespace {
 TEST(GlobalTermOccluder, PointLightInsideTheHeadReachesNothing) {
     const test::Slab slab;
     GlobalTermSettings s = slabSettings();
-    s.occluder = Sphere{Vec3f(0, 0.05f, 0), 0.01f};
+    s.surfaces = std::make_shared<const SurfaceScene>(std::vector<Sphere>{{Vec3f(0, 0.05f, 0), 0.01f}},
+                                                     std::vector<TriangleMesh>{});
     const auto model = makeExactModel(slab.groom(), constantTable(0.5f, 0.01f), s, {});
     EXPECT_TRUE(model->forLight(Light::point(Vec3f(0, 0.052f, 0)))->blocksEverything());
     EXPECT_FALSE(model->forLight(Light::point(Vec3f(0, 0.1f, 0)))->blocksEverything());
     EXPECT_FALSE(model->forLight(Light::directional(Vec3f(0, 1, 0)))->blocksEverything());
-    s.occluder.reset();
+    s.surfaces.reset();
     EXPECT_FALSE(makeExactModel(slab.groom(), constantTable(0.5f, 0.01f), s, {})
                      ->forLight(Light::point(Vec3f(0, 0.052f, 0)))
                      ->blocksEverything());

@@ -56,7 +56,7 @@ public:
 
     GlobalTermMode mode() const override { return GlobalTermMode::Exact; }
     std::unique_ptr<LightGlobalTerm> forLight(const Light& light) const override {
-        return withOccluder(std::make_unique<ExactLightGlobalTerm>(*this, light), settings.occluder,
+        return withSurfaces(std::make_unique<ExactLightGlobalTerm>(*this, light), settings.surfaces,
                             light);
     }
 
@@ -78,7 +78,8 @@ GlobalTerm ExactLightGlobalTerm::evaluateOne(const GlobalTermQuery& q,
     if (!(path.distance > 0))
         return GlobalTerm::unoccluded();
     const ExactOptions& opt = model_.options;
-    const std::optional<FiberPoint> own = model_.scene.locate(q.position, q.strand);
+    const std::optional<FiberPoint> own =
+        q.onFiber ? model_.scene.locate(q.position, q.strand) : std::nullopt;
     const float ownSlack = 2.0f * (opt.radius + model_.scene.ribbonWidth());
 
     Vec3f e1, e2;

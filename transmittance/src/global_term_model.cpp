@@ -9,8 +9,6 @@ namespace hairvox {
 void GlobalTermSettings::validate() const {
     fiberScale.validate();
     dualScattering.validate();
-    if (occluder && (!isFinite(occluder->center) || !(occluder->radius > 0)))
-        throw InputError("occluder sphere needs a finite centre and a radius > 0");
 }
 
 GlobalTerm globalTermFromDepths(float n, const Rgb& tauP, const Rgb& sumBeta2, float d_f) {
@@ -28,12 +26,12 @@ GlobalTerm globalTermFromDepths(float n, const Rgb& tauP, const Rgb& sumBeta2, f
 
 namespace {
 
-class OccludedLightGlobalTerm final : public LightGlobalTerm {
+class SurfaceShadowedGlobalTerm final : public LightGlobalTerm {
 public:
-    OccludedLightGlobalTerm(std::unique_ptr<LightGlobalTerm> inner, const Sphere& occluder,
-                            const Light& light)
+    SurfaceShadowedGlobalTerm(std::unique_ptr<LightGlobalTerm> inner,
+                              std::shared_ptr<const SurfaceScene> surfaces, const Light& light)
         : inner_(std::move(inner))
-        , occluder_(occluder)
+        , surfaces_(std::move(surfaces))
         , light_(light) {}
 
     GlobalTermStats evaluate(std::span<const GlobalTermQuery> queries,
@@ -44,7 +42,7 @@ public:
         openIndex.reserve(queries.size());
         for (std::size_t i = 0; i < queries.size(); ++i) {
             const Light::Path path = light_.pathFrom(queries[i].position);
-            if (occluder_.intersects(queries[i].position, path.omega, path.distance)) {
+            if (surfaces_->occluded(queries[i].position, path.omega, path.distance)) {
                 out[i] = GlobalTerm::blocked();
             } else {
                 open.push_back(queries[i]);
@@ -56,29 +54,30 @@ public:
         for (std::size_t k = 0; k < open.size(); ++k)
             out[openIndex[k]] = openOut[k];
         stats.queries = queries.size();
-        stats.blockedByOccluder += queries.size() - open.size();
+        stats.blockedBySurface += queries.size() - open.size();
         return stats;
     }
 
     bool blocksEverything() const override {
-        return (light_.kind == Light::Kind::Point && occluder_.contains(light_.position)) ||
+        return (light_.kind == Light::Kind::Point && surfaces_->contains(light_.position)) ||
                inner_->blocksEverything();
     }
 
 private:
     std::unique_ptr<LightGlobalTerm> inner_;
-    Sphere occluder_;
+    std::shared_ptr<const SurfaceScene> surfaces_;
     Light light_;
 };
 
 } // namespace
 
-std::unique_ptr<LightGlobalTerm> withOccluder(std::unique_ptr<LightGlobalTerm> inner,
-                                              const std::optional<Sphere>& occluder,
+std::unique_ptr<LightGlobalTerm> withSurfaces(std::unique_ptr<LightGlobalTerm> inner,
+                                              std::shared_ptr<const SurfaceScene> surfaces,
                                               const Light& light) {
-    if (!occluder)
+    if (!surfaces || surfaces->empty())
         return inner;
-    return std::make_unique<OccludedLightGlobalTerm>(std::move(inner), *occluder, light);
+    return std::make_unique<SurfaceShadowedGlobalTerm>(std::move(inner), std::move(surfaces),
+                                                       light);
 }
 
 } // namespace hairvox

@@ -237,7 +237,7 @@ private:
 
 std::unique_ptr<LightGlobalTerm> GridModel::forLight(const Light& light) const {
     throwIfInterrupted();
-    return withOccluder(std::make_unique<GridLightGlobalTerm>(*this, light), settings_.occluder,
+    return withSurfaces(std::make_unique<GridLightGlobalTerm>(*this, light), settings_.surfaces,
                         light);
 }
 

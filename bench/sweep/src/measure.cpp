@@ -29,10 +29,11 @@ std::vector<const Light*> litLights(const Scene& scene) {
 }
 
 /// The global term of the scene's mode toward every lit light at `points`,
-/// without the head (see the header comment).
+/// without the head and meshes (see the header comment).
 std::vector<std::vector<GlobalTerm>> probeTerms(Scene scene, const PipelineOptions& options,
                                                 const std::vector<GlobalTermQuery>& points) {
     scene.head.reset();
+    scene.meshes.clear();
     const std::unique_ptr<SceneAssets> assets = loadSceneAssets(scene, options);
     std::vector<std::vector<GlobalTerm>> terms;
     for (const Light* light : litLights(scene))

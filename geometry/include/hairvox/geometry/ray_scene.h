@@ -37,11 +37,12 @@
 // k·D·|ω × u| per unit length — what the rasterizer covers and what the grid
 // integrates (a fiber seen end-on blocks nothing).
 //
-// Surfaces: opaque spheres (the head), intersected analytically
-// (Sphere::intersect); they block light and end paths.
+// Surfaces: the scene's opaque spheres and meshes (geometry/surface_scene.h),
+// met before any fiber behind them; they block light and end paths.
 #pragma once
 
 #include <hairvox/core/vecmath.h>
+#include <hairvox/geometry/surface_scene.h>
 #include <hairvox/strands/fiber_scale.h>
 #include <hairvox/strands/groom.h>
 
@@ -88,15 +89,18 @@ struct RayHit {
     float t = 0;
     FiberPoint fiber{};       ///< Fiber: where, on which strand
     Vec3f tangent{0.0f};      ///< Fiber: unit shading tangent there, root → tip (shadingTangent)
-    Vec3f normal{0.0f};       ///< Surface: unit outward normal
+    Vec3f normal{0.0f};          ///< Surface: unit shading normal, facing the ray's origin
+    Vec3f geometricNormal{0.0f}; ///< Surface: unit, facing the ray's origin
     std::uint32_t surface = 0; ///< Surface: its index among the scene's surfaces
 };
 
 class RayScene {
 public:
     /// The groom's strands as ribbons of width scale.ribbonWidth() (locate()
-    /// searches within max(D, k·D) of a centreline) and opaque spheres.
-    RayScene(const Groom& groom, const FiberScale& scale, std::vector<Sphere> spheres = {});
+    /// searches within max(D, k·D) of a centreline) and the opaque surfaces
+    /// (null: none), which the RayScene shares.
+    RayScene(const Groom& groom, const FiberScale& scale,
+             std::shared_ptr<const SurfaceScene> surfaces = nullptr);
     ~RayScene();
     RayScene(const RayScene&) = delete;
     RayScene& operator=(const RayScene&) = delete;
@@ -129,7 +133,8 @@ public:
     }
 
     float ribbonWidth() const { return width_; }
-    const std::vector<Sphere>& spheres() const { return spheres_; }
+    /// Null when the scene has no surfaces.
+    const SurfaceScene* surfaces() const { return surfaces_.get(); }
 
 private:
     struct Impl;
@@ -140,7 +145,7 @@ private:
     std::unique_ptr<Impl> impl_;
     float width_;
     float locateDistance_;
-    std::vector<Sphere> spheres_;
+    std::shared_ptr<const SurfaceScene> surfaces_;
 };
 
 } // namespace hairvox

@@ -2,7 +2,8 @@
 // fibers with the same Marschner f_s (docs/DESIGN.md §8).
 //
 // Geometry: the strands as the ribbons exact mode casts against (width k·D,
-// geometry/ray_scene.h), opaque Lambertian spheres (the head), the
+// geometry/ray_scene.h), opaque Lambertian surfaces (spheres and triangle
+// meshes, geometry/surface_scene.h: a mesh's interpolated shading normal), the
 // rasterizer's pinhole camera (geometry/camera.h) with a box pixel filter. Every
 // ray that meets a fiber scatters there (the far-field f_s needs only the
 // tangent; nothing passes through a fiber unscattered, as dual scattering
@@ -52,7 +53,7 @@
 //                           rasterizer's layers of the same names
 //   multiple                paths of depth ≥ 2 whose first hit is a fiber: multiple
 //                           scattering (dual scattering's back_direct + scatter)
-//   head                    paths whose first hit is a surface
+//   surface                 paths whose first hit is a surface
 //   background              camera rays that meet nothing
 //   half_a, hair_half_a     the beauty and the hair's radiance (direct + multiple)
 //                           of half A alone: the noise of every comparison
@@ -63,21 +64,17 @@
 #include <hairvox/film/film.h>
 #include <hairvox/geometry/camera.h>
 #include <hairvox/geometry/light.h>
+#include <hairvox/geometry/surface_scene.h>
 #include <hairvox/shading/fiber_params.h>
 #include <hairvox/strands/fiber_scale.h>
 #include <hairvox/strands/groom.h>
 
 #include <cstdint>
+#include <memory>
 #include <ostream>
 #include <vector>
 
 namespace hairvox {
-
-/// An opaque Lambertian sphere (the head).
-struct LambertianSphere {
-    Sphere sphere;
-    Rgb albedo{0.5f};
-};
 
 /// What the path tracer sees: the same fibers, lights, camera and surfaces as
 /// the rasterizer.
@@ -87,7 +84,10 @@ struct PathTraceScene {
     FiberParams fiber;
     std::vector<Light> lights;
     CameraParams camera;
-    std::vector<LambertianSphere> spheres;
+    /// The opaque surfaces (null: none) and each one's Lambertian albedo, in
+    /// the surfaces' order (spheres, then meshes).
+    std::shared_ptr<const SurfaceScene> surfaces;
+    std::vector<Rgb> surfaceAlbedo;
     Rgb background{0.0f};
 };
 

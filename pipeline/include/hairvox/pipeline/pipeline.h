@@ -88,10 +88,24 @@ struct StageTimes {
     }
 };
 
+/// The scene's opaque surfaces — the head sphere, then the meshes in scene
+/// order — and each one's Lambertian albedo.
+struct SceneSurfaces {
+    std::shared_ptr<const SurfaceScene> scene; ///< null when the scene has none
+    std::vector<Rgb> albedo;                   ///< one per surface
+    std::vector<std::string> warnings;         ///< what the mesh readers dropped
+};
+
+/// Reads, generates and transforms the scene's meshes and builds their
+/// surface scene. InputError (naming the scene's meshes[i] and the file)
+/// for a mesh that cannot be used.
+SceneSurfaces loadSurfaces(const Scene& scene);
+
 /// Everything a scene's global term is computed from.
 struct SceneAssets {
     Groom groom;
     std::string groomWarnings;     ///< dropped segments etc., for the user
+    SceneSurfaces surfaces;
     std::optional<FiberGrid> grid; ///< present in the grid and approx modes
     std::unique_ptr<DualScatteringTables> tables;
     std::unique_ptr<GlobalTermModel> globalTerm; ///< refers to `grid`: keep the assets together
@@ -106,8 +120,8 @@ Groom loadGroom(const Scene& scene, std::string& warnings);
 /// The result must not be moved while globalTerm is in use (it refers to grid).
 std::unique_ptr<SceneAssets> loadSceneAssets(const Scene& scene, const PipelineOptions& options);
 
-/// The global-term settings a scene implies (fiber scale, d_f, the head as occluder).
-GlobalTermSettings globalTermSettings(const Scene& scene);
+/// The global-term settings a scene implies (fiber scale, d_f, its surfaces as occluders).
+GlobalTermSettings globalTermSettings(const Scene& scene, const SceneSurfaces& surfaces);
 /// The rasterizer settings a scene implies (fiber scale, shading rate, background).
 RasterSettings rasterSettings(const Scene& scene, const PipelineOptions& options = {});
 
@@ -157,9 +171,9 @@ std::vector<std::string> hairRadianceLayers(const Film& film);
 ComparedImage hairRadianceOf(const Film& film);
 
 /// What a path trace's samples depend on (groom content, fiber scale and
-/// optics, lights, camera, head, background, seed, depth settings): the key
+/// optics, lights, camera, surfaces and their content, background, seed, depth settings): the key
 /// under which a run may continue another.
-std::string pathTraceHash(const Scene& scene, const Groom& groom);
+std::string pathTraceHash(const Scene& scene, const Groom& groom, const SceneSurfaces& surfaces);
 
 /// The closing report: time per stage and what was skipped.
 void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& render);

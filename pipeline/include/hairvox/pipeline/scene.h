@@ -1,5 +1,5 @@
 // hairvox pipeline: the scene — everything a render needs besides the groom's
-// points: fiber scale and optics, lights, camera, the opaque head, global-term
+// points: fiber scale and optics, lights, camera, the opaque head and meshes, global-term
 // and output settings. Read from a JSON scene file whose schema (with an example
 // per feature) is docs/scene.md; the embedded default scene is
 // data/scenes/default.json, compiled into the library.
@@ -18,6 +18,7 @@
 #include <hairvox/film/image_file.h>
 #include <hairvox/geometry/camera.h>
 #include <hairvox/geometry/light.h>
+#include <hairvox/geometry/triangle_mesh.h>
 #include <hairvox/pathtrace/path_tracer.h>
 #include <hairvox/render/fragment_shader.h>
 #include <hairvox/shading/fiber_params.h>
@@ -51,6 +52,21 @@ struct GroomSource {
 struct Head {
     Sphere sphere{Vec3f(0.0f), 0.1f}; ///< radius in [1e-6, 1e4]
     Rgb albedo{0.55f, 0.40f, 0.33f};  ///< diffuse reflectance, each channel in [0, 1]
+};
+
+/// An opaque triangle mesh (a body, a head): it hides the hair behind it,
+/// blocks light in every global-term mode and in the path tracer, and is drawn
+/// as a Lambertian surface lit through the hair (the global term's V and T_s at
+/// the surface point). From an OBJ file, or generated: a mannequin head around
+/// a sphere (geometry/triangle_mesh.h generateHeadMesh()).
+struct MeshSource {
+    /// .obj, resolved against the scene file's directory; empty: the mannequin.
+    std::filesystem::path file;
+    Sphere mannequin{Vec3f(0.0f), 0.1f}; ///< the mannequin's cranium (its hair's head sphere)
+    MeshTransform transform;
+    Rgb albedo{0.55f, 0.40f, 0.33f}; ///< diffuse reflectance, each channel in [0, 1]
+
+    bool isMannequin() const { return file.empty(); }
 };
 
 /// Options of the `exact` global-term mode (DESIGN.md §5–6): K shadow rays per
@@ -91,6 +107,7 @@ struct Scene {
     std::vector<Light> lights; ///< at most 16 (each adds per-light AOV layers)
     CameraParams camera;
     std::optional<Head> head;
+    std::vector<MeshSource> meshes; ///< at most kMaxMeshes
     std::optional<float> voxelSize; ///< fiber grid voxel size; nullopt: derived from the groom
     Integrator integrator = Integrator::DualScattering;
     PathTraceSettings pathTrace; ///< the path integrator's spp, time limit, depth and seed
@@ -110,6 +127,7 @@ struct Scene {
 std::ostream& operator<<(std::ostream& os, const Scene& scene);
 
 inline constexpr std::size_t kMaxLights = 16;
+inline constexpr std::size_t kMaxMeshes = 64;
 inline constexpr std::uint64_t kMaxProceduralPoints = 1ull << 26;
 
 /// Reads and validates a scene file (at most 16 MiB). Relative groom paths are

@@ -53,7 +53,7 @@
 
 namespace hairvox {
 
-inline constexpr const char* kSurfaceLayer = "head";
+inline constexpr const char* kSurfaceLayer = "surface";
 inline constexpr const char* kBackgroundLayer = "background";
 inline constexpr const char* kHairAlphaLayer = "hair.A";
 inline constexpr const char* kDepthLayer = "Z";

@@ -11,6 +11,7 @@
 #include <hairvox/core/vecmath.h>
 #include <hairvox/geometry/light.h>
 #include <hairvox/geometry/ray_scene.h>
+#include <hairvox/geometry/surface_scene.h>
 #include <hairvox/shading/fiber_params.h>
 #include <hairvox/shading/global_term.h>
 #include <hairvox/transmittance/crossing_table.h>
@@ -25,22 +26,26 @@ namespace hairvox {
 
 /// A point on a fiber and that fiber's unit tangent (root → tip). The strand
 /// index, when the caller knows it, saves the exact mode a search for the
-/// point's own fiber.
+/// point's own fiber. A point on a surface (skin lit through the hair) is not
+/// on a fiber: no own fiber is searched for, and approx mode gives the fibers
+/// in front the orientation `tangent` (any unit vector ⟂ the light direction:
+/// fibers across the light, the common case of hair over skin).
 struct GlobalTermQuery {
     Vec3f position;
     Vec3f tangent;
     std::uint32_t strand = kUnknownStrand;
+    bool onFiber = true;
 };
 
 /// What a per-light evaluation skipped (DESIGN.md §7).
 struct GlobalTermStats {
     std::uint64_t queries = 0;
-    std::uint64_t blockedByOccluder = 0; ///< shadowed by the opaque head: no march, no rays
+    std::uint64_t blockedBySurface = 0; ///< shadowed by an opaque surface: no march, no rays
     std::uint64_t emptyPaths = 0;        ///< nothing in front: n = 0 without marching
 
     GlobalTermStats& operator+=(const GlobalTermStats& o) {
         queries += o.queries;
-        blockedByOccluder += o.blockedByOccluder;
+        blockedBySurface += o.blockedBySurface;
         emptyPaths += o.emptyPaths;
         return *this;
     }
@@ -54,8 +59,8 @@ public:
     /// any thread count and any batching.
     virtual GlobalTermStats evaluate(std::span<const GlobalTermQuery> queries,
                                      std::span<GlobalTerm> out) const = 0;
-    /// True when the light can reach no point at all (a point light inside the
-    /// opaque head): every query would be GlobalTerm::blocked(), so a renderer
+    /// True when the light can reach no point at all (a point light inside an
+    /// opaque surface): every query would be GlobalTerm::blocked(), so a renderer
     /// skips the light.
     virtual bool blocksEverything() const { return false; }
 };
@@ -64,7 +69,8 @@ public:
 struct GlobalTermSettings {
     FiberScale fiberScale; ///< D and k: optical depth λ·k·D·cos θ, ribbons k·D wide
     DualScatteringParams dualScattering;
-    std::optional<Sphere> occluder; ///< the opaque head: blocks light entirely
+    /// The opaque surfaces (head, meshes): they block light entirely. Null: none.
+    std::shared_ptr<const SurfaceScene> surfaces;
 
     void validate() const;
 };
@@ -86,10 +92,12 @@ public:
 GlobalTerm globalTermFromDepths(float n, const Rgb& tauP, const Rgb& sumBeta2, float d_f);
 
 /// Wraps a per-light evaluation so that points whose path to the light meets
-/// the settings' occluder get GlobalTerm::blocked() without being evaluated.
-/// Returns `inner` unchanged when there is no occluder.
-std::unique_ptr<LightGlobalTerm> withOccluder(std::unique_ptr<LightGlobalTerm> inner,
-                                              const std::optional<Sphere>& occluder,
+/// an opaque surface get GlobalTerm::blocked() without being evaluated: one
+/// shadow ray per point through the surfaces alone (SurfaceScene::occluded),
+/// exact in every mode — the grid modes do not voxelise surfaces. Returns
+/// `inner` unchanged when there are no surfaces.
+std::unique_ptr<LightGlobalTerm> withSurfaces(std::unique_ptr<LightGlobalTerm> inner,
+                                              std::shared_ptr<const SurfaceScene> surfaces,
                                               const Light& light);
 
 } // namespace hairvox
