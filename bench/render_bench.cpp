@@ -100,6 +100,40 @@ void BM_RenderHead1080p(benchmark::State& state) {
 BENCHMARK(BM_RenderHead1080p)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 /// Writing the default scene's film: arg 0 the EXR with every layer, 1 the PNG preview.
+/// What a 100k-triangle mesh costs a 1920×1080 grid render of the default
+/// groom (issue 15: ≤ 10% around the hair, < 5% far from it). Arg 0: the
+/// analytic head sphere alone (before meshes); 1: the mannequin head at
+/// 158 rings (99,856 triangles) instead; 2: the sphere, and that mannequin
+/// 5 m away (off screen and off every shadow path). End to end, no files.
+void BM_MeshCost1080p(benchmark::State& state) {
+    Scene scene = defaultScene();
+    scene.camera.width = 1920;
+    scene.camera.height = 1080;
+    scene.output.exr.clear();
+    scene.output.png.clear();
+    MeshSource mannequin = scene.meshes.at(0);
+    mannequin.mannequinRings = 158;
+    scene.meshes.clear();
+    if (state.range(0) != 1)
+        scene.head = Head{Sphere{scene.groom.procedural.headCenter, scene.groom.procedural.headRadius}};
+    if (state.range(0) == 1)
+        scene.meshes.push_back(mannequin);
+    if (state.range(0) == 2) {
+        mannequin.transform.translate = Vec3f(5.0f, 0.0f, 0.0f);
+        scene.meshes.push_back(mannequin);
+    }
+    SceneRender r;
+    for (auto _ : state)
+        r = renderScene(scene, {}, false);
+    state.counters["total_s"] = r.times.total();
+    state.counters["load_s"] = r.times.load;
+    state.counters["globalterm_s"] = r.times.globalTerm;
+    state.counters["raster_s"] = r.times.raster;
+    state.counters["shade_s"] = r.times.shade;
+    state.counters["fragments"] = double(r.raster->fragments);
+}
+BENCHMARK(BM_MeshCost1080p)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+
 void BM_WriteOutput(benchmark::State& state) {
     const Scene scene = defaultScene();
     const Groom groom = generateGroom(scene.groom.procedural);

@@ -7,6 +7,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/mat3x3.hpp>
 #include <glm/mat4x4.hpp>
+#include <tbb/parallel_for.h>
 #include <tiny_obj_loader.h>
 
 #include <charconv>
@@ -143,12 +144,16 @@ private:
     std::uint64_t positions_ = 0, normals_ = 0, texcoords_ = 0;
 };
 
+/// Lines end at '\n' or '\r' as tinyobjloader splits them (a lone '\r' too);
+/// messages count '\n' lines.
 void validateObjText(std::string_view text, const std::string& name) {
     ObjValidator validator(name);
     std::size_t number = 1;
-    for (std::size_t start = 0; start < text.size(); ++number) {
-        const std::size_t end = std::min(text.find('\n', start), text.size());
+    for (std::size_t start = 0; start < text.size();) {
+        const std::size_t end = std::min(text.find_first_of("\r\n", start), text.size());
         validator.line(text.substr(start, end - start), number);
+        if (end < text.size() && text[end] == '\n')
+            ++number;
         start = end + 1;
     }
 }
@@ -172,10 +177,17 @@ LoadedMesh parseObjMesh(std::string_view text, const std::string& name) {
     for (std::size_t i = 0; i < vertexCount; ++i)
         mesh.positions[i] = Vec3f(attrib.vertices[3 * i], attrib.vertices[3 * i + 1],
                                   attrib.vertices[3 * i + 2]);
+    // The check above makes every index valid; this guards against the two
+    // parsers ever disagreeing about a line.
+    const auto inconsistent = [&] {
+        return InputError(strCat(name, ": a face index names no vertex or normal"));
+    };
     const auto normalAt = [&](int index) {
         if (index < 0)
             return Vec3f(0.0f);
         const auto k = static_cast<std::size_t>(index);
+        if (3 * k + 2 >= attrib.normals.size())
+            throw inconsistent();
         return Vec3f(attrib.normals[3 * k], attrib.normals[3 * k + 1], attrib.normals[3 * k + 2]);
     };
 
@@ -189,6 +201,10 @@ LoadedMesh parseObjMesh(std::string_view text, const std::string& name) {
             offset += faceCorners;
             for (std::size_t k = 1; k + 1 < face.size(); ++k) {
                 const std::array<tinyobj::index_t, 3> c{face[0], face[k], face[k + 1]};
+                for (const tinyobj::index_t& corner : c)
+                    if (corner.vertex_index < 0 ||
+                        static_cast<std::size_t>(corner.vertex_index) >= vertexCount)
+                        throw inconsistent();
                 const std::array<std::uint32_t, 3> t{static_cast<std::uint32_t>(c[0].vertex_index),
                                                      static_cast<std::uint32_t>(c[1].vertex_index),
                                                      static_cast<std::uint32_t>(c[2].vertex_index)};
@@ -303,7 +319,7 @@ TriangleMesh generateHeadMesh(const Sphere& cranium, int rings) {
     const int segments = 2 * rings;
     const HeadShape shape;
     constexpr float kFar = 2.5f; // every direction leaves the head before this
-    constexpr int kSteps = 250;
+    constexpr int kSteps = 100;  // finer than the head's thinnest part (the nose)
     // The surface along a direction from the cranium's centre: the outermost
     // root of the distance (the head is star-shaped about the centre).
     const auto surfaceAlong = [&](const Vec3f& dir) {
@@ -314,29 +330,36 @@ TriangleMesh generateHeadMesh(const Sphere& cranium, int rings) {
                 break;
             outside = inside;
         }
-        for (int k = 0; k < 30; ++k) {
+        for (int k = 0; k < 24; ++k) {
             const float mid = 0.5f * (inside + outside);
             (shape.distance(mid * dir) < 0 ? inside : outside) = mid;
         }
         return 0.5f * (inside + outside) * dir;
     };
 
-    TriangleMesh mesh;
-    std::vector<Vec3f> unitPoints;
-    unitPoints.push_back(surfaceAlong(Vec3f(0, 1, 0))); // top pole
-    for (int i = 1; i < rings; ++i) {
+    // Vertices: the two poles and (rings − 1) rings of `segments`, in unit
+    // cranium coordinates, with the distance's gradient as their normal.
+    const std::size_t vertexCount = 2 + std::size_t(rings - 1) * std::size_t(segments);
+    std::vector<Vec3f> unitPoints(vertexCount), normals(vertexCount);
+    tbb::parallel_for(0, rings + 1, [&](int i) {
         const float theta = float(Pi) * float(i) / float(rings);
-        for (int j = 0; j < segments; ++j) {
+        const int count = i == 0 || i == rings ? 1 : segments;
+        for (int j = 0; j < count; ++j) {
             const float phi = float(TwoPi) * float(j) / float(segments);
-            unitPoints.push_back(surfaceAlong(Vec3f(std::sin(theta) * std::sin(phi), std::cos(theta),
-                                                    std::sin(theta) * std::cos(phi))));
+            const std::size_t v = i == 0        ? 0
+                                  : i == rings ? vertexCount - 1
+                                               : 1 + std::size_t(i - 1) * std::size_t(segments) +
+                                                     std::size_t(j);
+            unitPoints[v] = surfaceAlong(Vec3f(std::sin(theta) * std::sin(phi), std::cos(theta),
+                                               std::sin(theta) * std::cos(phi)));
+            normals[v] = shape.normal(unitPoints[v]);
         }
-    }
-    unitPoints.push_back(surfaceAlong(Vec3f(0, -1, 0))); // bottom pole
+    });
     const auto ringVertex = [&](int i, int j) {
         return static_cast<std::uint32_t>(1 + (i - 1) * segments + (j % segments));
     };
-    const auto bottom = static_cast<std::uint32_t>(unitPoints.size() - 1);
+    const auto bottom = static_cast<std::uint32_t>(vertexCount - 1);
+    TriangleMesh mesh;
     for (int j = 0; j < segments; ++j) {
         mesh.triangles.push_back({0, ringVertex(1, j), ringVertex(1, j + 1)});
         for (int i = 1; i + 1 < rings; ++i) {
@@ -347,13 +370,13 @@ TriangleMesh generateHeadMesh(const Sphere& cranium, int rings) {
         }
         mesh.triangles.push_back({ringVertex(rings - 1, j), bottom, ringVertex(rings - 1, j + 1)});
     }
-    mesh.positions.reserve(unitPoints.size());
+    mesh.positions.reserve(vertexCount);
     for (const Vec3f& p : unitPoints)
         mesh.positions.push_back(cranium.center + cranium.radius * p);
     mesh.cornerNormals.reserve(3 * mesh.triangles.size());
     for (const auto& t : mesh.triangles)
         for (const std::uint32_t v : t)
-            mesh.cornerNormals.push_back(shape.normal(unitPoints[v]));
+            mesh.cornerNormals.push_back(normals[v]);
     return mesh;
 }
 

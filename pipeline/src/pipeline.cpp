@@ -166,7 +166,7 @@ SceneSurfaces loadSurfaces(const Scene& scene) {
         const MeshSource& source = scene.meshes[i];
         try {
             if (source.isMannequin()) {
-                meshes.push_back(generateHeadMesh(source.mannequin));
+                meshes.push_back(generateHeadMesh(source.mannequin, source.mannequinRings));
             } else {
                 LoadedMesh loaded = readObjMesh(source.file);
                 meshes.push_back(std::move(loaded.mesh));

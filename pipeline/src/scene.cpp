@@ -290,6 +290,8 @@ MeshSource parseMesh(JsonObject obj, const std::filesystem::path& baseDir) {
             m.mannequin.center = v.vec3(kCoordinate);
         if (const JsonValue v = head["radius"]; v.present())
             m.mannequin.radius = v.numberF(kHeadRadius);
+        if (const JsonValue v = head["rings"]; v.present())
+            m.mannequinRings = static_cast<int>(v.integer(8, 1024));
         head.finish();
     }
     if (const JsonValue v = obj["transform"]; v.present())
@@ -376,6 +378,9 @@ void Scene::validate() const {
         if (m.isMannequin()) {
             requireInRange(field + ".mannequin.center", m.mannequin.center, kCoordinate);
             requireInRange(field + ".mannequin.radius", m.mannequin.radius, kHeadRadius);
+            if (m.mannequinRings < 8 || m.mannequinRings > 1024)
+                throw InputError(strCat(field, ".mannequin.rings = ", m.mannequinRings,
+                                        ": expected an integer in [8, 1024]"));
         }
         requireInRange(field + ".transform.scale", m.transform.scale, kMeshScale);
         if (m.transform.scale.x * m.transform.scale.y * m.transform.scale.z == 0.0f)

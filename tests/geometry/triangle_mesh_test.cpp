@@ -66,6 +66,9 @@ TEST(ObjMesh, BadFilesNameTheFileAndTheLine) {
     // Every triangle degenerate: an error, not an empty surface.
     EXPECT_EQ(errorOf("v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\nf 1 1 2\n"),
               "body.obj: no triangle of non-zero area (3 vertices, 2 degenerate triangles)");
+    // A lone carriage return ends a line, for tinyobjloader and for the check.
+    EXPECT_EQ(errorOf("v 0 0 0\nv 1 0 0\nv 0 1 0\n# x\rf 1 2 9\n"),
+              "body.obj: line 4: vertex index 9 is out of range: 3 vertex(s) defined before this line");
     // Relative (negative) indices are valid OBJ.
     EXPECT_EQ(parseObjMesh("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n", "rel.obj").mesh.triangleCount(), 1u);
     // A missing file.

@@ -318,6 +318,41 @@ TEST(Scene, ValidateChecksOverriddenFields) {
     EXPECT_THROW(s.validate(), InputError);
 }
 
+TEST(Scene, MeshesAreReadAndCheckedFieldByField) {
+    nlohmann::json j = validScene();
+    j["meshes"] = nlohmann::json::parse(R"([
+      {"file": "body.obj", "color": [0.5, 0.4, 0.3],
+       "transform": {"scale": 2, "rotate": [0, 90, 0], "translate": [1, 2, 3]}},
+      {"mannequin": {"center": [0, 1, 0], "radius": 0.2, "rings": 32}}
+    ])");
+    const Scene s = parseScene(j, "scene.json", "/scenes");
+    ASSERT_EQ(s.meshes.size(), 2u);
+    EXPECT_EQ(s.meshes[0].file, std::filesystem::path("/scenes/body.obj"));
+    EXPECT_EQ(s.meshes[0].transform.scale, Vec3f(2.0f));
+    EXPECT_EQ(s.meshes[0].transform.rotateDegrees, Vec3f(0.0f, 90.0f, 0.0f));
+    EXPECT_EQ(s.meshes[0].albedo, Rgb(0.5f, 0.4f, 0.3f));
+    EXPECT_TRUE(s.meshes[1].isMannequin());
+    EXPECT_EQ(s.meshes[1].mannequin.radius, 0.2f);
+    EXPECT_EQ(s.meshes[1].mannequinRings, 32);
+
+    const auto errorWith = [](const char* mesh) {
+        nlohmann::json bad = validScene();
+        bad["meshes"] = nlohmann::json::array({nlohmann::json::parse(mesh)});
+        return errorOf(bad);
+    };
+    EXPECT_EQ(errorWith(R"({"color": [1, 1, 1]})"),
+              "scene.json: /meshes/0: expected exactly one of \"file\" (an OBJ mesh) and "
+              "\"mannequin\" (a generated head)");
+    EXPECT_EQ(errorWith(R"({"file": 3})"), "scene.json: /meshes/0/file: expected a string, got 3");
+    EXPECT_NE(errorWith(R"({"file": "a.obj", "transform": {"scale": 0}})").find("/meshes/0/transform/scale"),
+              std::string::npos);
+    EXPECT_NE(errorWith(R"({"mannequin": {"rings": 4}})").find("/meshes/0/mannequin/rings"),
+              std::string::npos);
+    EXPECT_NE(errorWith(R"({"file": "a.obj", "colour": [1, 1, 1]})").find("colour"), std::string::npos);
+    EXPECT_NE(errorWith(R"({"file": "a.obj", "color": [2, 0, 0]})").find("/meshes/0/color"),
+              std::string::npos);
+}
+
 TEST(Scene, DefaultSceneIsTheShowcase) {
     const Scene s = defaultScene();
     EXPECT_TRUE(s.groom.isProcedural());

@@ -63,6 +63,7 @@ struct MeshSource {
     /// .obj, resolved against the scene file's directory; empty: the mannequin.
     std::filesystem::path file;
     Sphere mannequin{Vec3f(0.0f), 0.1f}; ///< the mannequin's cranium (its hair's head sphere)
+    int mannequinRings = 96; ///< its latitude rings, [8, 1024]: 4·rings·(rings − 1) triangles
     MeshTransform transform;
     Rgb albedo{0.55f, 0.40f, 0.33f}; ///< diffuse reflectance, each channel in [0, 1]
 
