@@ -133,6 +133,19 @@ MemoryEstimate estimateRenderMemory(const Scene& scene) {
         // A binary groom file holds 12–16 bytes per point.
         m.groom = ec ? 0 : std::uint64_t(size) / 12 * kBytesPerPoint;
     }
+    // Per triangle: indices, three corner normals and Embree's BVH (~150
+    // bytes); an OBJ file holds ~40 bytes per triangle and is read whole.
+    constexpr std::uint64_t kBytesPerTriangle = 150;
+    for (const MeshSource& mesh : scene.meshes) {
+        if (mesh.isMannequin()) {
+            const auto rings = std::uint64_t(mesh.mannequinRings);
+            m.meshes += 4 * rings * rings * kBytesPerTriangle;
+        } else {
+            std::error_code ec;
+            const std::uintmax_t size = std::filesystem::file_size(mesh.file, ec);
+            m.meshes += ec ? 0 : std::uint64_t(size) * (1 + kBytesPerTriangle / 40);
+        }
+    }
     return m;
 }
 
@@ -215,6 +228,24 @@ Groom loadGroom(const Scene& scene, std::string& warnings) {
         os << "dropped " << loaded.sanitized.droppedSegments << " zero-length segment(s); ";
     if (loaded.sanitized.droppedStrands > 0)
         os << "dropped " << loaded.sanitized.droppedStrands << " degenerate strand(s); ";
+    // Per-point attributes the renderer does not use yet: said, not ignored.
+    const Groom& g = loaded.groom;
+    std::vector<std::string> unused;
+    if (!g.thickness.empty()) {
+        const auto [lo, hi] = std::minmax_element(g.thickness.begin(), g.thickness.end());
+        unused.push_back(strCat("thickness (", *lo, " to ", *hi, ")"));
+    }
+    if (!g.color.empty())
+        unused.emplace_back("colour");
+    if (!g.transparency.empty())
+        unused.emplace_back("transparency");
+    if (!unused.empty()) {
+        os << scene.groom.file.string() << " carries per-point ";
+        for (std::size_t i = 0; i < unused.size(); ++i)
+            os << (i == 0 ? "" : i + 1 == unused.size() ? " and " : ", ") << unused[i];
+        os << ", which hairvox does not use yet: every strand is rendered with fiber.diameter = "
+           << scene.fiberScale.diameter << " and the scene's sigma_a; ";
+    }
     warnings = os.str();
     return std::move(loaded.groom);
 }
@@ -285,6 +316,8 @@ SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& opti
     SceneRender result;
     const std::unique_ptr<SceneAssets> assets = loadSceneAssets(scene, options);
     result.times = assets->times;
+    if (assets->surfaces.scene)
+        result.surfaceTriangles = assets->surfaces.scene->triangleCount();
     if (assets->grid) {
         result.activeVoxels = assets->grid->activeVoxelCount();
         result.voxelSize = assets->grid->info.voxelSize;
@@ -333,6 +366,8 @@ SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& opti
         rasterize(assets->groom, camera, fragmentShader, rasterSettings(scene, options), surfaces);
     result.film = std::move(image.film);
     result.raster = image.stats;
+    if (!assets->groomWarnings.empty())
+        result.warnings.push_back(assets->groomWarnings);
     for (const std::string& w : assets->surfaces.warnings)
         result.warnings.push_back(w);
     warnAboutLights(scene, assets->surfaces, result.warnings);
@@ -450,6 +485,7 @@ SceneRender renderScene(const Scene& scene, const PipelineOptions& options, bool
                                 " (film: ", memory.filmChannels,
                                 " float channels per pixel and the integrator's buffers, ",
                                 gib(double(memory.film)), "; groom: ", gib(double(memory.groom)),
+                                "; meshes: ", gib(double(memory.meshes)),
                                 "; the rest: ", gib(double(memory.fixed)),
                                 "), over the memory limit of ", gib(double(limit)),
                                 options.maxMemoryBytes > 0 ? "" : " (3/4 of the physical memory)",
@@ -609,7 +645,9 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
         return;
     }
     const RasterStats& st = *r.raster;
-    row("load", r.times.load, thousands(st.segments) + " segments");
+    row("load", r.times.load,
+        thousands(st.segments) + " segments" +
+            (r.surfaceTriangles > 0 ? ", " + thousands(r.surfaceTriangles) + " triangles" : ""));
     if (r.voxelSize > 0) {
         std::snprintf(line, sizeof(line), "%s active voxels of %.3g",
                       thousands(r.activeVoxels).c_str(), r.voxelSize);

@@ -60,11 +60,12 @@ std::uint64_t defaultMemoryLimit();
 struct MemoryEstimate {
     std::uint64_t film = 0;  ///< film layers + per-pixel integrator buffers + output encoding
     std::uint64_t groom = 0; ///< points, per-point render buffers, acceleration structure
+    std::uint64_t meshes = 0; ///< the OBJ text while read, triangles, normals, Embree's BVH
     /// Libraries, tables, the fiber grid and per-light caches of a typical
     /// groom (the default scene peaks at ~1.1 GiB at 2000², ~430 MiB at 500²).
     std::uint64_t fixed = 320ull << 20;
     int filmChannels = 0; ///< float channels per pixel in the film
-    std::uint64_t total() const { return film + groom + fixed; }
+    std::uint64_t total() const { return film + groom + meshes + fixed; }
 };
 MemoryEstimate estimateRenderMemory(const Scene& scene);
 
@@ -142,6 +143,7 @@ struct SceneRender {
     std::vector<LightReport> lights;
     std::vector<std::filesystem::path> written;
     std::uint64_t activeVoxels = 0; ///< of the fiber grid (0 in exact mode)
+    std::uint64_t surfaceTriangles = 0; ///< of the scene's meshes
     double voxelSize = 0;
 };
 
