@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <vector>
 
 namespace hairvox {
@@ -177,11 +178,15 @@ class GridLightGlobalTerm final : public LightGlobalTerm {
 public:
     GridLightGlobalTerm(const GridModel& model, const Light& light)
         : model_(model)
-        , light_(light)
-        , rates_(model.buildRates(light)) {
+        , light_(light) {
+        BrickVolume rates = model.buildRates(light);
         if (model.options().evaluation == GridEvaluation::Cache)
             cache_ =
-                LightSpaceCache::build(rates_, light, kOpaqueDepth, model.options().cacheSpacing);
+                LightSpaceCache::build(rates, light, kOpaqueDepth, model.options().cacheSpacing);
+        // The cache holds everything its lookups read: the rates (8 float
+        // lanes per voxel) are kept only for marching, not for the whole render.
+        if (!cache_)
+            rates_.emplace(std::move(rates));
     }
 
     GlobalTermStats evaluate(std::span<const GlobalTermQuery> queries,
@@ -213,7 +218,7 @@ private:
             d = cache_->lookup(q.position + start * path.omega);
             touched = d.n > 0;
         } else {
-            d = rates_.integrate(q.position, path.omega, start, path.distance, kOpaqueDepth,
+            d = rates_->integrate(q.position, path.omega, start, path.distance, kOpaqueDepth,
                                  touched);
         }
         const float d_f = model_.settings().dualScattering.d_f;
@@ -230,7 +235,8 @@ private:
 
     const GridModel& model_;
     Light light_;
-    BrickVolume rates_;
+    /// Present when evaluating by march (no cache, or a point light inside the volume).
+    std::optional<BrickVolume> rates_;
     /// Empty when evaluating by march, or for a point light inside the volume.
     std::optional<LightSpaceCache> cache_;
 };
