@@ -1,4 +1,4 @@
-#include "embree_check.h"
+#include "embree_util.h"
 
 #include <hairvox/core/error.h>
 #include <hairvox/geometry/ray_scene.h>
@@ -235,15 +235,7 @@ void RayScene::crossings(const Vec3f& origin, const Vec3f& dir, float tMax,
     collect.collect = &hits;
 
     RTCRayHit rayHit{};
-    rayHit.ray.org_x = origin.x;
-    rayHit.ray.org_y = origin.y;
-    rayHit.ray.org_z = origin.z;
-    rayHit.ray.dir_x = dir.x;
-    rayHit.ray.dir_y = dir.y;
-    rayHit.ray.dir_z = dir.z;
-    rayHit.ray.tnear = 0.0f;
-    rayHit.ray.tfar = std::min(tMax, std::numeric_limits<float>::max());
-    rayHit.ray.mask = ~0u;
+    rayHit.ray = makeRay(origin, dir, tMax);
     rayHit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(m.scene, &collect.context, &rayHit);
 
@@ -275,24 +267,6 @@ void RayScene::crossings(const Vec3f& origin, const Vec3f& dir, float tMax,
         pieces.push_back(h.primID);
     }
 }
-
-namespace {
-
-RTCRay makeRay(const Vec3f& origin, const Vec3f& dir, float tMax) {
-    RTCRay ray{};
-    ray.org_x = origin.x;
-    ray.org_y = origin.y;
-    ray.org_z = origin.z;
-    ray.dir_x = dir.x;
-    ray.dir_y = dir.y;
-    ray.dir_z = dir.z;
-    ray.tnear = 0.0f;
-    ray.tfar = std::min(tMax, std::numeric_limits<float>::max());
-    ray.mask = ~0u;
-    return ray;
-}
-
-} // namespace
 
 void RayScene::filterHits(const RTCFilterFunctionNArguments* args) {
     const auto* c = reinterpret_cast<const FilterContext*>(args->context);

@@ -1,4 +1,4 @@
-#include "embree_check.h"
+#include "embree_util.h"
 
 #include <hairvox/core/error.h>
 #include <hairvox/geometry/surface_scene.h>
@@ -39,20 +39,6 @@ bool segmentMeetsBox(const Bounds3f& b, const Vec3f& o, const Vec3f& d, float tM
             return false;
     }
     return true;
-}
-
-RTCRay makeRay(const Vec3f& origin, const Vec3f& dir, float tMax) {
-    RTCRay ray{};
-    ray.org_x = origin.x;
-    ray.org_y = origin.y;
-    ray.org_z = origin.z;
-    ray.dir_x = dir.x;
-    ray.dir_y = dir.y;
-    ray.dir_z = dir.z;
-    ray.tnear = 0.0f;
-    ray.tfar = std::min(tMax, std::numeric_limits<float>::max());
-    ray.mask = ~0u;
-    return ray;
 }
 
 struct MeshHit {
