@@ -116,6 +116,16 @@ ProceduralGroomParams parseProcedural(JsonObject obj) {
     return p;
 }
 
+/// A file named in the scene: a non-empty path, resolved against the scene
+/// file's directory unless absolute.
+std::filesystem::path scenePath(const JsonValue& v, const std::filesystem::path& baseDir) {
+    const std::string name = v.string();
+    if (name.empty())
+        v.failExpected("a non-empty path");
+    const std::filesystem::path path(name);
+    return path.is_absolute() ? path : baseDir / path;
+}
+
 GroomSource parseGroom(JsonObject obj, const std::filesystem::path& baseDir) {
     GroomSource g;
     const JsonValue file = obj["file"];
@@ -123,11 +133,7 @@ GroomSource parseGroom(JsonObject obj, const std::filesystem::path& baseDir) {
     if (file.present() == procedural.present())
         obj.fail("expected exactly one of \"file\" and \"procedural\"");
     if (file.present()) {
-        const std::string name = file.string();
-        if (name.empty())
-            file.failExpected("a non-empty path");
-        const std::filesystem::path path(name);
-        g.file = path.is_absolute() ? path : baseDir / path;
+        g.file = scenePath(file, baseDir);
     } else {
         g.procedural = parseProcedural(procedural.object());
     }
@@ -279,11 +285,7 @@ MeshSource parseMesh(JsonObject obj, const std::filesystem::path& baseDir) {
     if (file.present() == mannequin.present())
         obj.fail("expected exactly one of \"file\" (an OBJ mesh) and \"mannequin\" (a generated head)");
     if (file.present()) {
-        const std::string name = file.string();
-        if (name.empty())
-            file.failExpected("a non-empty path");
-        const std::filesystem::path path(name);
-        m.file = path.is_absolute() ? path : baseDir / path;
+        m.file = scenePath(file, baseDir);
     } else {
         JsonObject head = mannequin.object();
         if (const JsonValue v = head["center"]; v.present())
