@@ -118,6 +118,7 @@ SanitizeReport sanitizeGroom(Groom& groom, const std::string& source) {
     checkAttributeSize(groom.thickness, n, "thickness", source);
     checkAttributeSize(groom.transparency, n, "transparency", source);
     checkAttributeSize(groom.color, n, "color", source);
+    checkAttributeSize(groom.fiberType, n, "fiber type", source);
 
     for (std::size_t s = 0; s < groom.strandCount(); ++s) {
         const auto pts = groom.strand(s);
@@ -164,6 +165,7 @@ SanitizeReport sanitizeGroom(Groom& groom, const std::string& source) {
     keepSelected(groom.thickness, keep);
     keepSelected(groom.transparency, keep);
     keepSelected(groom.color, keep);
+    keepSelected(groom.fiberType, keep);
     groom.strandStart = newStart.size() > 1 ? std::move(newStart) : std::vector<std::uint32_t>{};
     return report;
 }

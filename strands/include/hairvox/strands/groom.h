@@ -9,6 +9,7 @@
 
 #include <hairvox/core/rgb.h>
 #include <hairvox/core/vecmath.h>
+#include <hairvox/strands/fiber_scale.h>
 
 #include <cstddef>
 #include <cstdint>
@@ -24,9 +25,19 @@ struct Groom {
     /// strandStart.size() == strandCount() + 1; strandStart.front() == 0 and
     /// strandStart.back() == points.size(). Empty for an empty groom.
     std::vector<std::uint32_t> strandStart;
-    std::vector<float> thickness;    ///< per point, optional (file semantics, not used for rendering)
-    std::vector<float> transparency; ///< per point, optional
-    std::vector<Rgb> color;          ///< per point, optional
+    /// Per point, optional: the fiber diameter D_i there. A reader stores the
+    /// file's values (.hair: a diameter in file units; .tfx: a per-strand
+    /// ratio); the pipeline resolves them into scene units before rendering
+    /// (scene key fiber.groom_thickness), and from then on every stage reads
+    /// D_i through ribbonWidthAt().
+    std::vector<float> thickness;
+    std::vector<float> transparency; ///< per point, optional (not rendered: a warning says so)
+    std::vector<Rgb> color;          ///< per point, optional (linear RGB reflectance)
+    /// Per point, optional: the fiber type — an index into the scene's fiber
+    /// palette (pipeline/fiber_palette.h) — of the segment that starts at the
+    /// point (a strand's last point repeats its last segment's). Empty: every
+    /// fiber is type 0.
+    std::vector<std::uint8_t> fiberType;
 
     std::size_t strandCount() const { return strandStart.empty() ? 0 : strandStart.size() - 1; }
     std::size_t pointCount() const { return points.size(); }
@@ -59,6 +70,19 @@ void strandTangents(std::span<const Vec3f> points, std::span<Vec3f> tangents);
 /// that degenerates).
 inline Vec3f shadingTangent(const Vec3f& t0, const Vec3f& t1, float t, const Vec3f& d) {
     return normalizeOr((1.0f - t) * t0 + t * t1, d);
+}
+
+/// The width k·D_i of the ray-facing ribbon at point i (fiber_scale.h): D_i
+/// is groom.thickness[i] when the groom carries per-point diameters, the
+/// scale's D otherwise. Along a segment the width is linear between its points.
+inline float ribbonWidthAt(const Groom& groom, const FiberScale& scale, std::size_t point) {
+    return groom.thickness.empty() ? scale.ribbonWidth()
+                                   : groom.thickness[point] * scale.densityMultiplier;
+}
+
+/// The fiber type of the segment starting at `point` (0 when the groom has none).
+inline std::uint8_t fiberTypeAt(const Groom& groom, std::size_t point) {
+    return groom.fiberType.empty() ? 0 : groom.fiberType[point];
 }
 
 /// Summary figures printed by `hairvox info` and recorded as grid metadata.
