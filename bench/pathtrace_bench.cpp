@@ -176,7 +176,7 @@ void BM_PathTrace512(benchmark::State& state) {
     PathTraceScene pts;
     pts.groom = &f.groom;
     pts.fiberScale = f.scene.fiberScale;
-    pts.fiber = f.scene.fiber;
+    pts.fibers = {f.scene.fiber};
     pts.lights = f.scene.lights;
     pts.camera = f.scene.camera;
     pts.camera.width = pts.camera.height = 512;

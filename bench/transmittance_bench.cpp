@@ -65,7 +65,7 @@ struct Fixture {
 
 void GridForLight(benchmark::State& state) {
     const Fixture& f = Fixture::get();
-    const auto model = makeGridModel(f.grid, f.crossings, f.settings, {});
+    const auto model = makeGridModel(f.grid, {f.crossings}, f.settings, {});
     for (auto _ : state)
         benchmark::DoNotOptimize(model->forLight(kLight));
     state.counters["voxels"] = double(f.grid.activeVoxelCount());
@@ -88,7 +88,7 @@ void queries(benchmark::State& state, const GlobalTermModel& model, std::size_t 
 
 void GridLookup(benchmark::State& state) {
     const Fixture& f = Fixture::get();
-    queries(state, *makeGridModel(f.grid, f.crossings, f.settings, {}), 1'000'000);
+    queries(state, *makeGridModel(f.grid, {f.crossings}, f.settings, {}), 1'000'000);
 }
 BENCHMARK(GridLookup)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 
@@ -96,7 +96,7 @@ void GridMarch(benchmark::State& state) {
     const Fixture& f = Fixture::get();
     GridOptions options;
     options.evaluation = GridEvaluation::March;
-    queries(state, *makeGridModel(f.grid, f.crossings, f.settings, options), 20'000);
+    queries(state, *makeGridModel(f.grid, {f.crossings}, f.settings, options), 20'000);
 }
 BENCHMARK(GridMarch)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 
@@ -105,7 +105,7 @@ void ExactRays(benchmark::State& state) {
     ExactOptions options;
     options.rays = static_cast<int>(state.range(0));
     options.radius = static_cast<float>(f.grid.info.voxelSize);
-    const auto model = makeExactModel(f.groom, f.crossings, f.settings, options);
+    const auto model = makeExactModel(f.groom, {f.crossings}, f.settings, options);
     queries(state, *model, std::size_t(2000 * 16 / options.rays + 16));
 }
 BENCHMARK(ExactRays)
@@ -118,7 +118,7 @@ BENCHMARK(ExactRays)
 
 void FrameGlobalTerm(benchmark::State& state) {
     const Fixture& f = Fixture::get();
-    const auto model = makeGridModel(f.grid, f.crossings, f.settings, {});
+    const auto model = makeGridModel(f.grid, {f.crossings}, f.settings, {});
     const auto count = static_cast<std::size_t>(state.range(0));
     const std::span<const GlobalTermQuery> points(f.points.data(), count);
     std::vector<GlobalTerm> out(count);
@@ -141,9 +141,9 @@ void ProbeAccuracy(benchmark::State& state) {
     ExactOptions exactOptions;
     exactOptions.rays = 256;
     exactOptions.radius = static_cast<float>(f.grid.info.voxelSize);
-    const auto exact = makeExactModel(f.groom, f.crossings, f.settings, exactOptions);
-    const auto grid = makeGridModel(f.grid, f.crossings, f.settings, {});
-    const auto approx = makeApproxModel(f.grid, f.crossings, f.settings, {});
+    const auto exact = makeExactModel(f.groom, {f.crossings}, f.settings, exactOptions);
+    const auto grid = makeGridModel(f.grid, {f.crossings}, f.settings, {});
+    const auto approx = makeApproxModel(f.grid, {f.crossings}, f.settings, {});
     const Vec3f lights[3] = {Vec3f(0.3f, 1, 0.4f), Vec3f(1, 0.2f, -0.3f), Vec3f(-0.2f, 0.3f, -1)};
     for (auto _ : state) {
         ProbeError g, a;

@@ -40,12 +40,11 @@ void runProbe(const ProbeOptions& opt) {
     Scene scene = opt.input.resolve();
     const ThreadLimit threadLimit(opt.threads);
     if (opt.samplePoints) {
-        std::string warnings;
-        const Groom groom = loadGroom(scene, warnings);
-        if (!warnings.empty())
-            std::cerr << "hairvox: warning: " << warnings << "\n";
+        const SceneGroom groom = loadGroom(scene);
+        for (const std::string& w : groom.warnings)
+            std::cerr << "hairvox: warning: " << w << "\n";
         const std::vector<GlobalTermQuery> points =
-            sampleFiberPoints(groom, *opt.samplePoints, opt.seed);
+            sampleFiberPoints(groom.groom, *opt.samplePoints, opt.seed);
         writeProbePoints(opt.output, points);
         std::cout << "wrote " << opt.output << ": " << points.size() << " points on the fibers of "
                   << scene.name << "\n";

@@ -45,12 +45,12 @@ void runTransmittance(const TransmittanceOptions& opt) {
     options.threads = opt.threads;
     const std::unique_ptr<SceneAssets> assets = loadSceneAssets(scene, options);
     if (!assets->grid) { // exact mode builds no grid: the voxels to query come from one
-        checkVoxelSizeForGroom(scene, assets->groom);
+        checkVoxelSizeForGroom(scene, assets->groom.groom);
         SplatOptions splat;
         splat.voxelSize = scene.voxelSize.value_or(0.0f);
         splat.fiberScale = scene.fiberScale;
         splat.sourceFile = scene.groom.file.string();
-        assets->grid = splatStrands(assets->groom, splat);
+        assets->grid = splatStrands(assets->groom.groom, splat);
     }
     const LitGrid lit = evaluateOnFiberGrid(*assets->grid, *assets->globalTerm->forLight(light));
     const auto evaluated = std::chrono::steady_clock::now();

@@ -126,9 +126,10 @@ Vec3f cosineDirection(const Vec3f& n, float u1, float u2) {
 class Tracer {
 public:
     Tracer(const PathTraceScene& scene, const PathTraceSettings& settings)
-        : scene_(scene), settings_(settings), camera_(scene.camera), bcsdf_(scene.fiber),
+        : scene_(scene), settings_(settings), camera_(scene.camera),
+          bcsdfs_(scene.fibers.begin(), scene.fibers.end()),
           rays_(*scene.groom, scene.fiberScale, scene.surfaces),
-          slack_(2.0f * scene.fiberScale.ribbonWidth()) {
+          slack_(2.0f * maxRibbonWidth(*scene.groom, scene.fiberScale)) {
         for (const Light& l : scene.lights)
             if (!l.isDark())
                 lights_.push_back(l);
@@ -184,6 +185,8 @@ public:
             if (hit->kind == RayHit::Kind::Fiber) {
                 const Vec3f& u = hit->tangent;
                 const RayOrigin here{hit->fiber, slack_};
+                const MarschnerBcsdf& bcsdf = bcsdfs_[fiberTypeAt(
+                    *scene_.groom, segmentStartPoint(hit->fiber.strand, hit->fiber.segment))];
                 for (const Light& light : lights_) {
                     const Light::Path path = light.pathFrom(xHit);
                     if (!(path.distance > 0))
@@ -194,7 +197,7 @@ public:
                     ++counters.shadowRays;
                     if (rays_.occluded(xHit, path.omega, path.distance, &here))
                         continue;
-                    const LobeValues f = bcsdf_.eval(a);
+                    const LobeValues f = bcsdf.eval(a);
                     const Rgb e = throughput * light.irradiance(path.distance) * a.cosTheta_i;
                     if (events == 1) {
                         out.add(kDirectR, e * f.R);
@@ -204,7 +207,7 @@ public:
                         out.add(deeper, e * f.sum());
                     }
                 }
-                const BcsdfSample s = bcsdf_.sample(
+                const BcsdfSample s = bcsdf.sample(
                     wo, u, {rng.uniformFloat(), rng.uniformFloat(), rng.uniformFloat(), rng.uniformFloat()});
                 if (!s.valid())
                     break;
@@ -263,7 +266,7 @@ private:
     const PathTraceScene& scene_;
     const PathTraceSettings& settings_;
     Camera camera_;
-    MarschnerBcsdf bcsdf_;
+    std::vector<MarschnerBcsdf> bcsdfs_; ///< per fiber type
     RayScene rays_;
     float slack_;
     std::vector<Light> lights_;
@@ -335,6 +338,8 @@ PathTraceOutput pathTrace(const PathTraceScene& scene, const PathTraceSettings& 
         throw std::invalid_argument("pathTrace: no groom");
     if (scene.surfaceAlbedo.size() != (scene.surfaces ? scene.surfaces->surfaceCount() : 0))
         throw std::invalid_argument("pathTrace: one albedo per surface is needed");
+    if (scene.fibers.size() < fiberTypeCount(*scene.groom))
+        throw std::invalid_argument("pathTrace: one fiber per fiber type of the groom is needed");
     scene.fiberScale.validate();
     const ThreadLimit threadLimit(settings.threads);
     const Tracer tracer(scene, settings);

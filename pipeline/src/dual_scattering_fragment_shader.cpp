@@ -1,6 +1,7 @@
 #include "dual_scattering_fragment_shader.h"
 
 #include <hairvox/core/math.h>
+#include <hairvox/strands/groom.h>
 
 #include <chrono>
 
@@ -28,9 +29,10 @@ void put(float* out, const Rgb& c) {
 } // namespace
 
 DualScatteringFragmentShader::DualScatteringFragmentShader(
-    const DualScatteringShader& shader, std::vector<Light> lights,
-    std::vector<std::unique_ptr<LightGlobalTerm>> lightTerms)
-    : shader_(shader)
+    std::vector<DualScatteringShader> shaders, std::span<const std::uint8_t> fiberType,
+    std::vector<Light> lights, std::vector<std::unique_ptr<LightGlobalTerm>> lightTerms)
+    : shaders_(std::move(shaders))
+    , fiberType_(fiberType)
     , lights_(std::move(lights))
     , terms_(std::move(lightTerms))
     , stats_(lights_.size()) {
@@ -51,7 +53,8 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
     std::fill(out.begin(), out.end(), 0.0f);
     std::vector<GlobalTermQuery> queries(points.size());
     for (std::size_t i = 0; i < points.size(); ++i)
-        queries[i] = {points[i].position, points[i].tangent, points[i].strand};
+        queries[i] = {points[i].position, points[i].tangent, points[i].strand, true,
+                      fiberTypeAt(fiberType_, points[i].segment)};
     std::vector<GlobalTerm> terms(points.size());
     std::vector<ShadeResult> radiance(points.size());
     std::int64_t globalTermNanos = 0;
@@ -77,7 +80,8 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
             if (!terms_[l] || (g.V == 0 && g.T_s.isBlack()))
                 continue; // no light arrives: nothing to shade
             const Light::Path path = light.pathFrom(p.position);
-            const ShadeResult r = shader_.shade(path.omega, p.toCamera, p.tangent, g);
+            const ShadeResult r =
+                shaders_[queries[i].fiberType].shade(path.omega, p.toCamera, p.tangent, g);
             const Rgb e = light.irradiance(path.distance);
             ShadeResult& sum = radiance[i];
             sum.directR += e * r.directR;

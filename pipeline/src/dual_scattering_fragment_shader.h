@@ -8,6 +8,7 @@
 //             scattering) scatter                          F_scatter·cos θ_i (global multiple
 //             scattering)
 //   averages  per light l: l.V, l.n (scalars), l.T_s, l.sigma_f (RGB, σ_f = √σ_f²)
+// A point is shaded with the shader of its segment's fiber type (Groom::fiberType).
 #pragma once
 
 #include <hairvox/geometry/light.h>
@@ -18,15 +19,19 @@
 #include <atomic>
 #include <memory>
 #include <mutex>
+#include <span>
 #include <vector>
 
 namespace hairvox::detail {
 
 class DualScatteringFragmentShader final : public FragmentShader {
 public:
-    /// `lightTerms[l]` is the global term toward lights[l], or null for a light
-    /// that is skipped (contributes nothing; its AOVs read "blocked").
-    DualScatteringFragmentShader(const DualScatteringShader& shader, std::vector<Light> lights,
+    /// `shaders[t]` shades fiber type t; `fiberType` is the groom's
+    /// (Groom::fiberType, empty for an untyped groom; it must outlive the
+    /// shader). `lightTerms[l]` is the global term toward lights[l], or null
+    /// for a light that is skipped (contributes nothing; its AOVs read "blocked").
+    DualScatteringFragmentShader(std::vector<DualScatteringShader> shaders,
+                                 std::span<const std::uint8_t> fiberType, std::vector<Light> lights,
                                  std::vector<std::unique_ptr<LightGlobalTerm>> lightTerms);
 
     const ShaderLayout& layout() const override { return layout_; }
@@ -39,7 +44,8 @@ public:
     std::vector<GlobalTermStats> stats() const;
 
 private:
-    DualScatteringShader shader_;
+    std::vector<DualScatteringShader> shaders_; ///< per fiber type
+    std::span<const std::uint8_t> fiberType_;
     std::vector<Light> lights_;
     std::vector<std::unique_ptr<LightGlobalTerm>> terms_;
     ShaderLayout layout_;

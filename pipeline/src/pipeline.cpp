@@ -216,50 +216,49 @@ RasterSettings rasterSettings(const Scene& scene, const PipelineOptions& options
     return s;
 }
 
-Groom loadGroom(const Scene& scene, std::string& warnings) {
-    warnings.clear();
-    if (scene.groom.isProcedural())
-        return generateGroom(scene.groom.procedural);
+SceneGroom loadGroom(const Scene& scene) {
+    SceneGroom g;
+    if (scene.groom.isProcedural()) {
+        g.groom = generateGroom(scene.groom.procedural);
+        g.palette.fibers.push_back(scene.fiber);
+        return g;
+    }
+    const std::string source = scene.groom.file.string();
     LoadedGroom loaded = readGroom(scene.groom.file);
-    std::ostringstream os;
-    for (const std::string& w : loaded.warnings)
-        os << w << "; ";
+    g.warnings = std::move(loaded.warnings);
     if (loaded.sanitized.droppedSegments > 0)
-        os << "dropped " << loaded.sanitized.droppedSegments << " zero-length segment(s); ";
+        g.warnings.push_back(
+            strCat("dropped ", loaded.sanitized.droppedSegments, " zero-length segment(s)"));
     if (loaded.sanitized.droppedStrands > 0)
-        os << "dropped " << loaded.sanitized.droppedStrands << " degenerate strand(s); ";
-    // Per-point attributes the renderer does not use yet: said, not ignored.
-    const Groom& g = loaded.groom;
-    std::vector<std::string> unused;
-    if (!g.thickness.empty()) {
-        const auto [lo, hi] = std::minmax_element(g.thickness.begin(), g.thickness.end());
-        unused.push_back(strCat("thickness (", *lo, " to ", *hi, ")"));
-    }
-    if (!g.color.empty())
-        unused.emplace_back("colour");
-    if (!g.transparency.empty())
-        unused.emplace_back("transparency");
-    if (!unused.empty()) {
-        os << scene.groom.file.string() << " carries per-point ";
-        for (std::size_t i = 0; i < unused.size(); ++i)
-            os << (i == 0 ? "" : i + 1 == unused.size() ? " and " : ", ") << unused[i];
-        os << ", which hairvox does not use yet: every strand is rendered with fiber.diameter = "
-           << scene.fiberScale.diameter << " and the scene's sigma_a; ";
-    }
-    warnings = os.str();
-    return std::move(loaded.groom);
+        g.warnings.push_back(
+            strCat("dropped ", loaded.sanitized.droppedStrands, " degenerate strand(s)"));
+    g.groom = std::move(loaded.groom);
+    if (std::string note = resolveThickness(g.groom, scene.groom.thickness, scene.fiberScale,
+                                            source, g.warnings);
+        !note.empty())
+        g.notes.push_back(std::move(note));
+    g.palette = resolveColors(g.groom, scene.groom.color, scene.fiber, source, g.warnings);
+    if (!g.palette.colors.empty())
+        g.notes.push_back(strCat(g.palette.size(), " fiber type(s) from the file's colours (",
+                                 "groom.color \"use\"): sigma_a replaces the scene's"));
+    else if (!g.groom.color.empty())
+        g.notes.push_back("per-point colours ignored (groom.color \"ignore\")");
+    if (!g.groom.transparency.empty())
+        g.warnings.push_back(strCat(source, " carries per-point transparency, which hairvox does "
+                                            "not render: every fiber is opaque"));
+    return g;
 }
 
 std::unique_ptr<SceneAssets> loadSceneAssets(const Scene& scene, const PipelineOptions& options) {
     auto assets = std::make_unique<SceneAssets>();
     auto start = Clock::now();
-    assets->groom = loadGroom(scene, assets->groomWarnings);
+    assets->groom = loadGroom(scene);
     assets->surfaces = loadSurfaces(scene);
     assets->times.load = secondsSince(start);
     throwIfInterrupted();
 
     if (scene.globalTermMode != GlobalTermMode::Exact) {
-        checkVoxelSizeForGroom(scene, assets->groom);
+        checkVoxelSizeForGroom(scene, assets->groom.groom);
         start = Clock::now();
         SplatOptions splat;
         splat.voxelSize = scene.voxelSize.value_or(0.0f);
@@ -274,20 +273,23 @@ std::unique_ptr<SceneAssets> loadSceneAssets(const Scene& scene, const PipelineO
                 std::min(splat.memoryBudgetBytes,
                          options.maxMemoryBytes > used ? options.maxMemoryBytes - used : 1);
         }
-        assets->grid = splatStrands(assets->groom, splat);
+        assets->grid = splatStrands(assets->groom.groom, splat);
         assets->times.voxelize = secondsSince(start);
     }
 
     start = Clock::now();
     TableBuildOptions tableOptions;
     tableOptions.d_b = scene.dualScattering.d_b;
-    assets->tables = std::make_unique<DualScatteringTables>(DualScatteringTables::loadOrBuild(
-        scene.fiber, options.tableCacheDir.empty() ? defaultTableCacheDir() : options.tableCacheDir,
-        tableOptions));
+    CrossingTables crossings;
+    for (const FiberParams& fiber : assets->groom.palette.fibers) {
+        assets->tables.push_back(DualScatteringTables::loadOrBuild(
+            fiber, options.tableCacheDir.empty() ? defaultTableCacheDir() : options.tableCacheDir,
+            tableOptions));
+        crossings.push_back(CrossingTable::fromDualScattering(assets->tables.back()));
+    }
     assets->times.tables = secondsSince(start);
 
     start = Clock::now();
-    const CrossingTable crossings = CrossingTable::fromDualScattering(*assets->tables);
     const GlobalTermSettings settings = globalTermSettings(scene, assets->surfaces);
     switch (scene.globalTermMode) {
     case GlobalTermMode::Exact: {
@@ -295,14 +297,17 @@ std::unique_ptr<SceneAssets> loadSceneAssets(const Scene& scene, const PipelineO
         exact.rays = static_cast<int>(scene.exact.rays);
         exact.radius = scene.exact.radius;
         exact.seed = scene.exact.seed;
-        assets->globalTerm = makeExactModel(assets->groom, crossings, settings, exact);
+        assets->globalTerm =
+            makeExactModel(assets->groom.groom, std::move(crossings), settings, exact);
         break;
     }
     case GlobalTermMode::Grid:
-        assets->globalTerm = makeGridModel(*assets->grid, crossings, settings, options.grid);
+        assets->globalTerm =
+            makeGridModel(*assets->grid, std::move(crossings), settings, options.grid);
         break;
     case GlobalTermMode::Approx:
-        assets->globalTerm = makeApproxModel(*assets->grid, crossings, settings, options.grid);
+        assets->globalTerm =
+            makeApproxModel(*assets->grid, std::move(crossings), settings, options.grid);
         break;
     }
     assets->times.globalTerm = secondsSince(start);
@@ -358,22 +363,27 @@ SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& opti
     }
     const double surfaceSeconds = secondsSince(surfacesStart);
 
-    const MarschnerBcsdf bcsdf(scene.fiber);
-    const DualScatteringShader shader(bcsdf, *assets->tables, scene.dualScattering);
-    const detail::DualScatteringFragmentShader fragmentShader(shader, scene.lights,
-                                                              std::move(terms));
-    RasterOutput image =
-        rasterize(assets->groom, camera, fragmentShader, rasterSettings(scene, options), surfaces);
+    // One shader per fiber type (the shaders refer to their bcsdf and tables).
+    const SceneGroom& groom = assets->groom;
+    std::vector<MarschnerBcsdf> bcsdfs(groom.palette.fibers.begin(), groom.palette.fibers.end());
+    std::vector<DualScatteringShader> shaders;
+    for (std::size_t t = 0; t < bcsdfs.size(); ++t)
+        shaders.emplace_back(bcsdfs[t], assets->tables[t], scene.dualScattering);
+    const detail::DualScatteringFragmentShader fragmentShader(
+        std::move(shaders), groom.groom.fiberType, scene.lights, std::move(terms));
+    RasterOutput image = rasterize(groom.groom, camera, fragmentShader,
+                                   rasterSettings(scene, options), surfaces);
     result.film = std::move(image.film);
     result.raster = image.stats;
-    if (!assets->groomWarnings.empty())
-        result.warnings.push_back(assets->groomWarnings);
+    result.fiberTypes = groom.palette.size();
+    result.groomNotes = groom.notes;
+    result.warnings.insert(result.warnings.end(), groom.warnings.begin(), groom.warnings.end());
     for (const std::string& w : assets->surfaces.warnings)
         result.warnings.push_back(w);
     warnAboutLights(scene, assets->surfaces, result.warnings);
     for (std::string& w : image.warnings)
         result.warnings.push_back(std::move(w));
-    warnIfNoHairSeen(scene, result.film, &assets->groom, result.warnings);
+    warnIfNoHairSeen(scene, result.film, &groom.groom, result.warnings);
 
     // The renderer's shading time includes the global-term evaluations made
     // inside the shader: apportion it by the shader's own thread time.
@@ -402,15 +412,16 @@ SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& opti
 SceneRender renderPathTraced(const Scene& scene, const PipelineOptions& options, bool writeFiles) {
     SceneRender result;
     auto start = Clock::now();
-    std::string groomWarnings;
-    const Groom groom = loadGroom(scene, groomWarnings);
-    if (!groomWarnings.empty())
-        result.warnings.push_back(groomWarnings);
+    const SceneGroom sceneGroom = loadGroom(scene);
+    const Groom& groom = sceneGroom.groom;
+    result.warnings = sceneGroom.warnings;
+    result.fiberTypes = sceneGroom.palette.size();
+    result.groomNotes = sceneGroom.notes;
     const SceneSurfaces surfaces = loadSurfaces(scene);
     for (const std::string& w : surfaces.warnings)
         result.warnings.push_back(w);
     result.times.load = secondsSince(start);
-    const std::string hash = pathTraceHash(scene, groom, surfaces);
+    const std::string hash = pathTraceHash(scene, sceneGroom, surfaces);
 
     // Continue from the scene's own earlier output, if asked and it is there.
     std::optional<Film> previous;
@@ -441,7 +452,7 @@ SceneRender renderPathTraced(const Scene& scene, const PipelineOptions& options,
     PathTraceScene pts;
     pts.groom = &groom;
     pts.fiberScale = scene.fiberScale;
-    pts.fiber = scene.fiber;
+    pts.fibers = sceneGroom.palette.fibers;
     pts.lights = scene.lights;
     pts.camera = scene.camera;
     pts.surfaces = surfaces.scene;
@@ -517,11 +528,15 @@ ComparedImage hairRadianceOf(const Film& film) {
                                    film.find("hair_half_a") ? "hair_half_a" : std::string_view{});
 }
 
-std::string pathTraceHash(const Scene& scene, const Groom& groom, const SceneSurfaces& surfaces) {
+std::string pathTraceHash(const Scene& scene, const SceneGroom& groom,
+                          const SceneSurfaces& surfaces) {
     Hasher h;
-    h.value(contentHash(groom));
+    h.value(contentHash(groom.groom));
+    h.values(std::span<const float>(groom.groom.thickness));
+    h.values(std::span<const std::uint8_t>(groom.groom.fiberType));
     scene.fiberScale.hashInto(h);
-    scene.fiber.hashInto(h);
+    for (const FiberParams& fiber : groom.palette.fibers)
+        fiber.hashInto(h);
     for (const Light& l : scene.lights) {
         h.value(l.kind).value(l.direction).value(l.position).value(l.color).value(l.intensity);
         h.string(l.name);
@@ -648,6 +663,8 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
     row("load", r.times.load,
         thousands(st.segments) + " segments" +
             (r.surfaceTriangles > 0 ? ", " + thousands(r.surfaceTriangles) + " triangles" : ""));
+    for (const std::string& note : r.groomNotes)
+        row("", 0.0, note);
     if (r.voxelSize > 0) {
         std::snprintf(line, sizeof(line), "%s active voxels of %.3g",
                       thousands(r.activeVoxels).c_str(), r.voxelSize);
@@ -655,7 +672,8 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
     } else {
         row("voxelize", r.times.voxelize, "not needed (exact mode)");
     }
-    row("tables", r.times.tables, "dual-scattering tables (disk cache)");
+    row("tables", r.times.tables,
+        strCat("dual-scattering tables (disk cache), ", r.fiberTypes, " fiber type(s)"));
     std::uint64_t queries = 0, blocked = 0, empty = 0, skippedLights = 0;
     for (const LightReport& l : r.lights) {
         queries += l.stats.queries;

@@ -137,6 +137,10 @@ GroomSource parseGroom(JsonObject obj, const std::filesystem::path& baseDir) {
     } else {
         g.procedural = parseProcedural(procedural.object());
     }
+    if (const JsonValue v = obj["thickness"]; v.present())
+        g.thickness = v.oneOf(kGroomThicknessNames);
+    if (const JsonValue v = obj["color"]; v.present())
+        g.color = v.oneOf(kGroomColorNames);
     obj.finish();
     return g;
 }
@@ -164,9 +168,14 @@ void parseFiber(JsonObject obj, Scene& scene) {
     };
     set("eta", [&](const JsonValue& v) { f.eta = v.numberF(kAny); });
     const JsonValue melanin = obj["melanin"];
-    if (melanin.present() && obj.has("sigma_a"))
-        melanin.fail("give either sigma_a or melanin, not both");
+    const int absorptionKeys =
+        int(obj.has("sigma_a")) + int(melanin.present()) + int(obj.has("color"));
+    if (absorptionKeys > 1)
+        obj.fail("give one of sigma_a, melanin and color, not several");
     set("sigma_a", [&](const JsonValue& v) { f.sigma_a = v.rgb(kAny); });
+    set("color", [&](const JsonValue& v) {
+        f.sigma_a = FiberParams::sigmaFromColor(v.rgb(kAlbedo));
+    });
     if (melanin.present()) {
         JsonObject m = melanin.object();
         const JsonValue eu = m["eumelanin"], pheo = m["pheomelanin"];
@@ -554,7 +563,8 @@ std::ostream& operator<<(std::ostream& os, const Scene& s) {
     if (s.groom.isProcedural())
         os << s.groom.procedural;
     else
-        os << s.groom.file.string();
+        os << s.groom.file.string() << " (thickness " << toString(s.groom.thickness) << ", color "
+           << toString(s.groom.color) << ")";
     os << ", " << s.fiberScale << ", " << s.fiber << ", " << s.dualScattering << ", "
        << s.lights.size() << " lights";
     for (const Light& l : s.lights)

@@ -1,6 +1,9 @@
 #include <hairvox/core/error.h>
 #include <hairvox/shading/fiber_params.h>
 
+#include <algorithm>
+#include <cmath>
+
 namespace hairvox {
 
 namespace {
@@ -21,6 +24,18 @@ Rgb FiberParams::sigmaFromMelanin(float eumelanin, float pheomelanin) {
     requireRange("eumelanin", eumelanin, 0.0f, 20.0f);
     requireRange("pheomelanin", pheomelanin, 0.0f, 20.0f);
     return eumelanin * Rgb(0.419f, 0.697f, 1.37f) + pheomelanin * Rgb(0.187f, 0.4f, 1.05f);
+}
+
+Rgb FiberParams::sigmaFromColor(const Rgb& color) {
+    const float b = kColorRoughness;
+    const float f = 5.969f - 0.215f * b + 2.532f * b * b - 10.73f * b * b * b +
+                    5.574f * b * b * b * b + 0.245f * b * b * b * b * b;
+    Rgb sigma;
+    for (int c = 0; c < 3; ++c) {
+        const float lnC = std::log(std::clamp(color[c], kMinColor, 1.0f)) / f;
+        sigma[c] = lnC * lnC;
+    }
+    return sigma;
 }
 
 void FiberParams::validate() const {

@@ -170,4 +170,18 @@ SanitizeReport sanitizeGroom(Groom& groom, const std::string& source) {
     return report;
 }
 
+std::size_t fiberTypeCount(const Groom& groom) {
+    std::size_t types = 1;
+    for (std::uint8_t t : groom.fiberType)
+        types = std::max<std::size_t>(types, t + 1u);
+    return types;
+}
+
+float maxRibbonWidth(const Groom& groom, const FiberScale& scale) {
+    if (groom.thickness.empty())
+        return scale.ribbonWidth();
+    return *std::max_element(groom.thickness.begin(), groom.thickness.end()) *
+           scale.densityMultiplier;
+}
+
 } // namespace hairvox

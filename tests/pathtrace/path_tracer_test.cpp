@@ -74,7 +74,7 @@ TEST(PathTracer, OneFiberSingleScatteringIsMarschner) {
     PathTraceSettings settings;
     settings.spp = 256;
     const Film film = pathTrace(scene, settings).film;
-    const MarschnerBcsdf bcsdf(scene.fiber);
+    const MarschnerBcsdf bcsdf(scene.fibers[0]);
     const Camera camera(scene.camera);
     LobeValues expected;
     double coverage = 0;

@@ -213,28 +213,6 @@ TEST(Meshes, RatboyRendersItsMohawkOnItsBody) {
     EXPECT_TRUE(r.warnings.empty()) << r.warnings.front();
 }
 
-TEST(GroomAttributes, ThoseTheRendererDoesNotUseAreWarnedAbout) {
-    // Issue 15 §2: a groom's per-point thickness, colour and transparency are
-    // not used yet; a render says so instead of ignoring them silently.
-    test::TempDir dir;
-    for (const Integrator integrator : {Integrator::DualScattering, Integrator::Path}) {
-        Scene scene = slabScene(dir, GlobalTermMode::Grid);
-        scene.integrator = integrator;
-        scene.pathTrace.spp = 2;
-        Groom groom = strandSlab();
-        groom.thickness.assign(groom.pointCount(), 1e-4f);
-        groom.thickness[3] = 2e-4f;
-        groom.color.assign(groom.pointCount(), Rgb(0.8f, 0.6f, 0.3f));
-        writeHairFile(scene.groom.file, groom);
-        const SceneRender r = renderScene(scene, options(dir), false);
-        ASSERT_EQ(r.warnings.size(), 1u) << toString(integrator);
-        EXPECT_NE(r.warnings[0].find("slab.hair carries per-point thickness (0.0001 to 0.0002) and "
-                                     "colour, which hairvox does not use yet"),
-                  std::string::npos)
-            << r.warnings[0];
-    }
-}
-
 TEST(Meshes, BadMeshesAreErrorsNamingTheSceneEntryAndTheFile) {
     test::TempDir dir;
     Scene scene = slabScene(dir, GlobalTermMode::Grid);

@@ -226,7 +226,11 @@ TEST(Scene, UnknownKeysAreErrors) {
 TEST(Scene, ConflictingAndDuplicateSettingsAreErrors) {
     nlohmann::json j = validScene();
     j["fiber"] = {{"sigma_a", {0.2, 0.3, 0.5}}, {"melanin", {{"eumelanin", 1}}}};
-    EXPECT_EQ(errorOf(j), "scene.json: /fiber/melanin: give either sigma_a or melanin, not both");
+    EXPECT_EQ(errorOf(j),
+              "scene.json: /fiber: give one of sigma_a, melanin and color, not several");
+    j["fiber"] = {{"sigma_a", {0.2, 0.3, 0.5}}, {"color", {0.5, 0.4, 0.3}}};
+    EXPECT_EQ(errorOf(j),
+              "scene.json: /fiber: give one of sigma_a, melanin and color, not several");
     j = validScene();
     j["lights"][0]["name"] = "key";
     j["lights"][1]["name"] = "key";
@@ -351,6 +355,28 @@ TEST(Scene, MeshesAreReadAndCheckedFieldByField) {
     EXPECT_NE(errorWith(R"({"file": "a.obj", "colour": [1, 1, 1]})").find("colour"), std::string::npos);
     EXPECT_NE(errorWith(R"({"file": "a.obj", "color": [2, 0, 0]})").find("/meshes/0/color"),
               std::string::npos);
+}
+
+TEST(Scene, GroomAttributeRulesAndFiberColourAreRead) {
+    nlohmann::json j = validScene();
+    j["groom"] = {{"file", "x.hair"}, {"thickness", "scale"}, {"color", "ignore"}};
+    j["fiber"] = {{"color", {0.5, 0.4, 0.3}}};
+    const Scene s = parseScene(j, "scene.json", "/scenes");
+    EXPECT_EQ(s.groom.thickness, GroomThickness::Scale);
+    EXPECT_EQ(s.groom.color, GroomColor::Ignore);
+    EXPECT_EQ(s.fiber.sigma_a, FiberParams::sigmaFromColor(Rgb(0.5f, 0.4f, 0.3f)));
+    const Scene d = parseScene(validScene(), "scene.json", "/scenes");
+    EXPECT_EQ(d.groom.thickness, GroomThickness::Auto);
+    EXPECT_EQ(d.groom.color, GroomColor::Use);
+
+    j["groom"]["thickness"] = "radius";
+    EXPECT_NE(errorOf(j).find("/groom/thickness"), std::string::npos) << errorOf(j);
+    j["groom"]["thickness"] = "diameter";
+    j["groom"]["color"] = true;
+    EXPECT_NE(errorOf(j).find("/groom/color"), std::string::npos) << errorOf(j);
+    j["groom"]["color"] = "use";
+    j["fiber"]["color"] = {1.5, 0, 0};
+    EXPECT_NE(errorOf(j).find("/fiber/color"), std::string::npos) << errorOf(j);
 }
 
 TEST(Scene, DefaultSceneIsTheShowcase) {

@@ -36,7 +36,7 @@ public:
         ExactOptions exact;
         exact.rays = 256;
         exact.radius = static_cast<float>(referenceVoxel); // the footprint the grid resolves
-        const auto model = makeExactModel(groom_, crossings_, settings_, exact);
+        const auto model = makeExactModel(groom_, {crossings_}, settings_, exact);
         for (const Vec3f& l : lights_)
             reference_.push_back(evaluateGlobalTerm(*model, Light::directional(l), points_));
     }
@@ -48,8 +48,8 @@ public:
 
     Result measure(const FiberGrid& grid, GlobalTermMode mode, const GridOptions& options) const {
         const auto model = mode == GlobalTermMode::Approx
-                               ? makeApproxModel(grid, crossings_, settings_, options)
-                               : makeGridModel(grid, crossings_, settings_, options);
+                               ? makeApproxModel(grid, {crossings_}, settings_, options)
+                               : makeGridModel(grid, {crossings_}, settings_, options);
         Result r;
         const auto start = std::chrono::steady_clock::now();
         for (std::size_t l = 0; l < lights_.size(); ++l) {

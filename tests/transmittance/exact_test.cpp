@@ -34,7 +34,7 @@ void expectSlabMatchesPoissonClosedForms(float densityMultiplier) {
     options.radius = 0.004f;
     GlobalTermSettings s = slabSettings();
     s.fiberScale.densityMultiplier = densityMultiplier;
-    const auto model = makeExactModel(groom, constantTable(aBar, 0.02f), s, options);
+    const auto model = makeExactModel(groom, {constantTable(aBar, 0.02f)}, s, options);
 
     for (const Vec3f dir : {Vec3f(0, 1, 0), Vec3f(0.5f, 1, 0), Vec3f(0, 1, 0.6f),
                             Vec3f(-0.4f, 1, 0.4f), Vec3f(0.8f, 1, -0.2f)}) {
@@ -82,7 +82,8 @@ TEST(ExactGlobalTerm, DensityMultiplierAddsIndependentHairs) {
 
 TEST(ExactGlobalTerm, EmptySpaceIsExactlyUnoccluded) {
     const test::Slab slab;
-    const auto model = makeExactModel(slab.groom(), constantTable(0.5f, 0.01f), slabSettings(), {});
+    const auto model =
+        makeExactModel(slab.groom(), {constantTable(0.5f, 0.01f)}, slabSettings(), {});
     // Above the slab looking up, and beside it looking sideways: nothing in front.
     for (const auto& [p, dir] : {std::pair{Vec3f(0, 0.05f, 0), Vec3f(0, 1, 0)},
                                  std::pair{Vec3f(0, 0.005f, 0.2f), Vec3f(0, 0, 1)}}) {
@@ -102,7 +103,7 @@ TEST(ExactGlobalTerm, OwnFiberDoesNotShadowItself) {
     ExactOptions options;
     options.rays = 32;
     options.radius = 0.0005f;
-    const auto model = makeExactModel(groom, constantTable(0.5f, 0.01f), slabSettings(), options);
+    const auto model = makeExactModel(groom, {constantTable(0.5f, 0.01f)}, slabSettings(), options);
     for (float t : {0.1f, 0.5f, 0.99f}) {
         const Vec3f p = lerp(t, line[1], line[2]);
         for (const Vec3f dir :
@@ -124,7 +125,7 @@ TEST(ExactGlobalTerm, CurlComingBackCounts) {
                            {-0.01f, 0.002f, -0.0005f},
                            {-0.01f, 0.004f, 0}};
     groom.addStrand(curl);
-    const auto model = makeExactModel(groom, constantTable(0.5f, 0.01f), slabSettings(), {});
+    const auto model = makeExactModel(groom, {constantTable(0.5f, 0.01f)}, slabSettings(), {});
     for (const std::uint32_t hint : {kUnknownStrand, 0u}) {
         GlobalTerm g;
         const GlobalTermQuery q{Vec3f(0, 0, 0), Vec3f(1, 0, 0), hint};
@@ -139,7 +140,7 @@ TEST(ExactGlobalTerm, OccluderBlocksLight) {
     GlobalTermSettings s = slabSettings();
     s.surfaces = std::make_shared<const SurfaceScene>(std::vector<Sphere>{{Vec3f(0, 0.05f, 0), 0.01f}},
                                                      std::vector<TriangleMesh>{});
-    const auto model = makeExactModel(slab.groom(), constantTable(0.5f, 0.01f), s, {});
+    const auto model = makeExactModel(slab.groom(), {constantTable(0.5f, 0.01f)}, s, {});
     const auto light = model->forLight(Light::point(Vec3f(0, 0.1f, 0)));
     const GlobalTermQuery queries[2] = {{Vec3f(0, -0.001f, 0), Vec3f(1, 0, 0)},
                                         {Vec3f(0.04f, -0.001f, 0), Vec3f(1, 0, 0)}};
@@ -157,7 +158,7 @@ TEST(ExactGlobalTerm, IndependentOfBatchingAndOrder) {
     options.rays = 8;
     options.radius = 0.002f;
     const auto model =
-        makeExactModel(slab.groom(), constantTable(0.5f, 0.01f), slabSettings(), options);
+        makeExactModel(slab.groom(), {constantTable(0.5f, 0.01f)}, slabSettings(), options);
     const auto light = model->forLight(Light::directional(Vec3f(0.3f, 1, 0.1f)));
     std::vector<GlobalTermQuery> queries;
     for (int i = 0; i < 50; ++i)
@@ -183,12 +184,12 @@ TEST(GlobalTermOccluder, PointLightInsideTheHeadReachesNothing) {
     GlobalTermSettings s = slabSettings();
     s.surfaces = std::make_shared<const SurfaceScene>(std::vector<Sphere>{{Vec3f(0, 0.05f, 0), 0.01f}},
                                                      std::vector<TriangleMesh>{});
-    const auto model = makeExactModel(slab.groom(), constantTable(0.5f, 0.01f), s, {});
+    const auto model = makeExactModel(slab.groom(), {constantTable(0.5f, 0.01f)}, s, {});
     EXPECT_TRUE(model->forLight(Light::point(Vec3f(0, 0.052f, 0)))->blocksEverything());
     EXPECT_FALSE(model->forLight(Light::point(Vec3f(0, 0.1f, 0)))->blocksEverything());
     EXPECT_FALSE(model->forLight(Light::directional(Vec3f(0, 1, 0)))->blocksEverything());
     s.surfaces.reset();
-    EXPECT_FALSE(makeExactModel(slab.groom(), constantTable(0.5f, 0.01f), s, {})
+    EXPECT_FALSE(makeExactModel(slab.groom(), {constantTable(0.5f, 0.01f)}, s, {})
                      ->forLight(Light::point(Vec3f(0, 0.052f, 0)))
                      ->blocksEverything());
 }

@@ -1,6 +1,8 @@
 #include "slab.h"
 
+#include <hairvox/core/error.h>
 #include <hairvox/core/math.h>
+#include <hairvox/transmittance/exact_global_term.h>
 #include <hairvox/transmittance/grid_global_term.h>
 #include <hairvox/voxelize/fiber_grid.h>
 
@@ -33,7 +35,7 @@ TEST(GridGlobalTerm, SlabMatchesClosedForms) {
         options.orientation = model;
         options.startOffset = 0;
         const auto gridModel =
-            makeGridModel(grid, constantTable(aBar, 0.02f), slabSettings(), options);
+            makeGridModel(grid, {constantTable(aBar, 0.02f)}, slabSettings(), options);
         for (const Vec3f dir : {Vec3f(0, 1, 0), Vec3f(0.5f, 1, 0), Vec3f(0, 1, 0.6f),
                                 Vec3f(-0.4f, 1, 0.4f), Vec3f(0.8f, 1, -0.2f)}) {
             const Vec3f omega = glm::normalize(dir);
@@ -67,7 +69,7 @@ TEST(GridGlobalTerm, EmptySpaceIsExactlyUnoccluded) {
     const test::Slab slab;
     const FiberGrid grid = splat(slab.groom(), 0.002);
     for (const auto make : {&makeGridModel, &makeApproxModel}) {
-        const auto model = make(grid, constantTable(0.5f, 0.01f), slabSettings(), {});
+        const auto model = make(grid, {constantTable(0.5f, 0.01f)}, slabSettings(), {});
         for (const auto& [p, dir] : {std::pair{Vec3f(0, 0.05f, 0), Vec3f(0, 1, 0)},
                                      std::pair{Vec3f(0, 0.005f, 0.2f), Vec3f(0, 0, 1)},
                                      std::pair{Vec3f(5, 5, 5), Vec3f(1, 1, 1)}}) {
@@ -92,7 +94,7 @@ TEST(GridGlobalTerm, CrossingCountIsSymmetric) {
     const FiberGrid grid = splat(slab.groom(), 0.002);
     GridOptions options;
     options.evaluation = GridEvaluation::March; // the integrator itself, no cache interpolation
-    const auto model = makeGridModel(grid, constantTable(0.5f, 0.01f), slabSettings(), options);
+    const auto model = makeGridModel(grid, {constantTable(0.5f, 0.01f)}, slabSettings(), options);
     Pcg32 rng(9);
     for (int i = 0; i < 16; ++i) {
         const Vec3f a(rng.uniform(-0.01f, 0.01f), -0.004f, rng.uniform(-0.05f, 0.05f));
@@ -115,17 +117,73 @@ TEST(GridGlobalTerm, PoissonKeepsTransmittanceNonNegativeWhereGeometricCannot) {
     const GlobalTermQuery q{Vec3f(0, -0.005f, 0), Vec3f(1, 0, 0)};
     GridOptions options;
     options.estimator = AttenuationEstimator::Poisson;
-    makeGridModel(grid, constantTable(0.2f, 0.01f), slabSettings(), options)
+    makeGridModel(grid, {constantTable(0.2f, 0.01f)}, slabSettings(), options)
         ->forLight(Light::directional(Vec3f(0, 1, 0)))
         ->evaluate({&q, 1}, {&poisson, 1});
     options.estimator = AttenuationEstimator::Geometric;
-    makeGridModel(grid, constantTable(0.2f, 0.01f), slabSettings(), options)
+    makeGridModel(grid, {constantTable(0.2f, 0.01f)}, slabSettings(), options)
         ->forLight(Light::directional(Vec3f(0, 1, 0)))
         ->evaluate({&q, 1}, {&geometric, 1});
     EXPECT_GT(poisson.T_s.r, 0.0f);
     EXPECT_GT(poisson.P.r, poisson.V);
     EXPECT_LT(geometric.P.r, geometric.V); // the raw geometric form would make T_s negative
     EXPECT_EQ(geometric.T_s.r, 0.0f);      // and is clamped
+}
+
+/// Mean P (red) of the global term straight up, from 400 points below the slab.
+double meanPBelowSlab(const GlobalTermModel& model) {
+    const auto light = model.forLight(Light::directional(Vec3f(0, 1, 0)));
+    std::vector<GlobalTermQuery> queries;
+    Pcg32 rng(5);
+    for (int i = 0; i < 400; ++i)
+        queries.push_back({Vec3f(rng.uniform(-0.015f, 0.015f), -0.005f, rng.uniform(-0.08f, 0.08f)),
+                           Vec3f(1, 0, 0)});
+    std::vector<GlobalTerm> out(queries.size());
+    light->evaluate(queries, out);
+    double P = 0;
+    for (const GlobalTerm& g : out)
+        P += double(g.P.r) / double(out.size());
+    return P;
+}
+
+// Two fiber types in one slab: crossings are Poisson with each type half the
+// time, so E[∏ā_f] = exp(−n·(1 − (ā_0 + ā_1)/2)). Exact mode attenuates each
+// crossing by its own type, the grid mixes the types' rates by the splatted
+// fractions; both must find the mixture, and a slab of type 1 only must find
+// ā_1 alone (the type is read, not assumed).
+TEST(GridGlobalTerm, FiberTypesMixTheirRatesAsExactModeFindsThem) {
+    const test::Slab slab;
+    const float a0 = 0.9f, a1 = 0.2f;
+    const CrossingTables tables{constantTable(a0, 0.01f), constantTable(a1, 0.01f)};
+    const double n = slab.expectedN(Vec3f(0, 1, 0), kDiameter);
+    Groom mixed = slab.groom();
+    mixed.fiberType.resize(mixed.pointCount());
+    for (std::size_t i = 0; i < mixed.pointCount(); ++i)
+        mixed.fiberType[i] = static_cast<std::uint8_t>((i / 2) % 2); // strand by strand
+    Groom allType1 = slab.groom();
+    allType1.fiberType.assign(allType1.pointCount(), 1);
+    // allType1: type 0 is declared (two tables) but no fiber has it.
+    for (const auto& [groom, aMean] :
+         {std::pair<const Groom&, double>{mixed, 0.5 * (double(a0) + double(a1))},
+          std::pair<const Groom&, double>{allType1, double(a1)}}) {
+        const double expected = std::exp(-n * (1.0 - aMean));
+        const FiberGrid grid = splat(groom, 0.002);
+        ASSERT_EQ(grid.fiberTypeCount(), 2u);
+        GridOptions options;
+        options.startOffset = 0;
+        EXPECT_NEAR(meanPBelowSlab(*makeGridModel(grid, tables, slabSettings(), options)),
+                    expected, 0.01)
+            << "grid, mean a_f " << aMean;
+        ExactOptions exact;
+        exact.rays = 64;
+        exact.radius = 0.004f;
+        EXPECT_NEAR(meanPBelowSlab(*makeExactModel(groom, tables, slabSettings(), exact)),
+                    expected, 0.02)
+            << "exact, mean a_f " << aMean;
+    }
+    // One table for a two-type groom is refused.
+    EXPECT_THROW(makeExactModel(mixed, {constantTable(a0, 0.01f)}, slabSettings(), {}),
+                 InputError);
 }
 
 } // namespace

@@ -1,3 +1,4 @@
+#include "test_util.h"
 #include "voxelize/voxelize_test_util.h"
 
 #include <hairvox/core/error.h>
@@ -481,6 +482,76 @@ TEST(Splat, RefusesNonFinitePoints) {
     } catch (const InputError& e) {
         EXPECT_NE(std::string(e.what()).find("strand 1, point 1"), std::string::npos) << e.what();
     }
+}
+
+// ---------------------------------------------------------------------------
+// Per-point diameters and fiber types (fiber_grid.h).
+
+TEST(Splat, PerPointDiameterWeighsTheLengthDensityByDOverNominal) {
+    const Groom plain = groomOf({{Vec3f(-0.31f, 0.02f, 0.0f), Vec3f(0.0f, 0.11f, 0.05f),
+                                  Vec3f(0.29f, 0.0f, -0.04f)}});
+    SplatOptions options = withVoxelSize(0.05);
+    options.fiberScale.diameter = 1e-4f;
+    const double length = test::exactLength(plain);
+    // Twice the nominal diameter everywhere: twice the fibers.
+    Groom thick = plain;
+    thick.thickness.assign(3, 2e-4f);
+    EXPECT_NEAR(test::splattedLength(splatStrands(thick, options)), 2 * length, 1e-5 * length);
+    // Tapered 2D → D → 0: segment means 1.5 D and 0.5 D.
+    Groom tapered = plain;
+    tapered.thickness = {2e-4f, 1e-4f, 0.0f};
+    const double l0 = glm::length(Vec3d(plain.points[1]) - Vec3d(plain.points[0]));
+    const double l1 = glm::length(Vec3d(plain.points[2]) - Vec3d(plain.points[1]));
+    EXPECT_NEAR(test::splattedLength(splatStrands(tapered, options)), 1.5 * l0 + 0.5 * l1,
+                1e-5 * length);
+    // The orientation is weighted the same way: D̄ = 0 on the second segment
+    // leaves only the first one's direction.
+    Groom firstOnly = plain;
+    firstOnly.thickness = {1e-4f, 0.0f, 0.0f};
+    const FiberGrid g = splatStrands(firstOnly, options);
+    const Vec3d u0 = glm::normalize(Vec3d(plain.points[1]) - Vec3d(plain.points[0]));
+    for (auto it = g.density->cbeginValueOn(); it; ++it)
+        expectVecNear(orientation(g, it.getCoord()), u0, 1e-5, it.getCoord());
+}
+
+TEST(Splat, FiberTypesGetFractionsThatSumToOneAndSurviveTheVdbFile) {
+    // Two crossing strands of types 0 and 2 (type 1 unused), and a strand
+    // whose second segment changes type.
+    Groom groom = groomOf({{Vec3f(-0.2f, 0.0f, 0.0f), Vec3f(0.2f, 0.0f, 0.0f)},
+                           {Vec3f(0.0f, -0.2f, 0.01f), Vec3f(0.0f, 0.2f, 0.01f)},
+                           {Vec3f(0.0f, 0.1f, -0.2f), Vec3f(0.0f, 0.1f, 0.0f),
+                            Vec3f(0.0f, 0.1f, 0.2f)}});
+    groom.fiberType = {0, 0, 2, 2, 0, 1, 1};
+    const FiberGrid grid = splatStrands(groom, withVoxelSize(0.02));
+    ASSERT_EQ(grid.fiberTypeCount(), 3u);
+    double typeLength[3] = {0, 0, 0};
+    const double h = grid.info.voxelSize;
+    for (auto it = grid.density->cbeginValueOn(); it; ++it) {
+        float sum = 0;
+        for (std::size_t t = 0; t < 3; ++t) {
+            const float f = grid.typeFraction[t]->tree().getValue(it.getCoord());
+            EXPECT_GE(f, 0.0f);
+            sum += f;
+            typeLength[t] += double(f) * double(*it) * h * h * h;
+        }
+        EXPECT_NEAR(sum, 1.0f, 1e-5f) << it.getCoord();
+    }
+    // Each type's splatted length is its segments' length.
+    EXPECT_NEAR(typeLength[0], 0.4 + 0.2, 1e-4);
+    EXPECT_NEAR(typeLength[1], 0.2, 1e-4);
+    EXPECT_NEAR(typeLength[2], 0.4, 1e-4);
+    // Untyped, the same groom has no fraction grids and the same density.
+    Groom untyped = groom;
+    untyped.fiberType.clear();
+    const FiberGrid plain = splatStrands(untyped, withVoxelSize(0.02));
+    EXPECT_TRUE(plain.typeFraction.empty());
+    EXPECT_TRUE(test::sameGrid(*plain.density, *grid.density));
+
+    test::TempDir dir;
+    writeFiberGrid(dir / "typed.vdb", grid);
+    EXPECT_TRUE(test::sameFiberGrid(readFiberGrid(dir / "typed.vdb"), grid));
+    // Deterministic for any thread count.
+    EXPECT_TRUE(test::sameFiberGrid(test::splatWithThreads(groom, withVoxelSize(0.02), 1), grid));
 }
 
 } // namespace

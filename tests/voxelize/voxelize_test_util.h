@@ -49,8 +49,11 @@ bool sameGrid(const GridT& a, const GridT& b) {
 
 inline bool sameFiberGrid(const FiberGrid& a, const FiberGrid& b) {
     if (!sameGrid(*a.density, *b.density) || !sameGrid(*a.orientation, *b.orientation) ||
-        a.hasTensor() != b.hasTensor())
+        a.hasTensor() != b.hasTensor() || a.typeFraction.size() != b.typeFraction.size())
         return false;
+    for (std::size_t t = 0; t < a.typeFraction.size(); ++t)
+        if (!sameGrid(*a.typeFraction[t], *b.typeFraction[t]))
+            return false;
     return !a.hasTensor() ||
            (sameGrid(*a.tensorDiag, *b.tensorDiag) && sameGrid(*a.tensorOffDiag, *b.tensorOffDiag));
 }

@@ -76,4 +76,10 @@ CrossingTable::Rates CrossingTable::rates(float sinTheta) const {
             cosTheta * lerp(t, a.values.beta2Bar_f, b.values.beta2Bar_f)};
 }
 
+void checkCrossingTables(const CrossingTables& tables, std::size_t fiberTypes) {
+    if (tables.size() < std::max<std::size_t>(fiberTypes, 1))
+        throw InputError(strCat("the groom has ", fiberTypes, " fiber type(s) but ",
+                                tables.size(), " crossing table(s) were given: one per type"));
+}
+
 } // namespace hairvox

@@ -47,10 +47,11 @@ private:
 
 class ExactModel final : public GlobalTermModel {
 public:
-    ExactModel(const Groom& groom, const CrossingTable& crossingTable,
+    ExactModel(const Groom& groom, CrossingTables crossingTables,
                const GlobalTermSettings& globalSettings, const ExactOptions& exactOptions)
         : scene(groom, globalSettings.fiberScale)
-        , crossings(crossingTable)
+        , fiberType(groom.fiberType)
+        , crossings(std::move(crossingTables))
         , settings(globalSettings)
         , options(exactOptions) {}
 
@@ -61,7 +62,8 @@ public:
     }
 
     RayScene scene;
-    CrossingTable crossings;
+    std::vector<std::uint8_t> fiberType; ///< the groom's (Groom::fiberType)
+    CrossingTables crossings;            ///< per fiber type
     GlobalTermSettings settings;
     ExactOptions options;
 };
@@ -105,8 +107,10 @@ GlobalTerm ExactLightGlobalTerm::evaluateOne(const GlobalTermQuery& q,
                                             glm::distance(origin + c.t * path.omega, q.position),
                                             ownSlack))
                 continue; // the point's own fiber, not a curl coming back
+            const std::uint8_t type =
+                fiberTypeAt(model_.fiberType, segmentStartPoint(c.strand, c.segment));
             const CrossingTable::Values v =
-                model_.crossings.crossing(glm::dot(path.omega, c.tangent));
+                model_.crossings[type].crossing(glm::dot(path.omega, c.tangent));
             logP += v.logABar_f;
             beta2 += v.beta2Bar_f;
             ++m;
@@ -144,12 +148,13 @@ GlobalTermStats ExactLightGlobalTerm::evaluate(std::span<const GlobalTermQuery> 
 
 } // namespace
 
-std::unique_ptr<GlobalTermModel> makeExactModel(const Groom& groom, const CrossingTable& crossings,
+std::unique_ptr<GlobalTermModel> makeExactModel(const Groom& groom, CrossingTables crossings,
                                                 const GlobalTermSettings& settings,
                                                 const ExactOptions& options) {
     settings.validate();
     options.validate();
-    return std::make_unique<ExactModel>(groom, crossings, settings, options);
+    checkCrossingTables(crossings, fiberTypeCount(groom));
+    return std::make_unique<ExactModel>(groom, std::move(crossings), settings, options);
 }
 
 } // namespace hairvox

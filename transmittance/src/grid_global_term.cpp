@@ -12,6 +12,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -92,11 +93,11 @@ CrossingTable::Rates expectedRates(const VoxelFibers& v, const Vec3f& omega,
 
 class GridModel final : public GlobalTermModel {
 public:
-    GridModel(GlobalTermMode mode, const FiberGrid& grid, const CrossingTable& crossings,
+    GridModel(GlobalTermMode mode, const FiberGrid& grid, CrossingTables crossings,
               const GlobalTermSettings& settings, const GridOptions& options)
         : mode_(mode)
         , grid_(grid)
-        , crossings_(crossings)
+        , crossings_(std::move(crossings))
         , settings_(settings)
         , options_(options) {}
 
@@ -106,7 +107,8 @@ public:
     /// Per-light rates at every active voxel of the fiber grid.
     BrickVolume buildRates(const Light& light) const;
 
-    const CrossingTable& crossings() const { return crossings_; }
+    /// The crossing table of fiber type `type`.
+    const CrossingTable& crossings(std::uint8_t type) const { return crossings_.at(type); }
     const GlobalTermSettings& settings() const { return settings_; }
     const GridOptions& options() const { return options_; }
     double voxelSize() const { return grid_.info.voxelSize; }
@@ -114,7 +116,7 @@ public:
 private:
     GlobalTermMode mode_;
     const FiberGrid& grid_;
-    CrossingTable crossings_;
+    CrossingTables crossings_; ///< per fiber type
     GlobalTermSettings settings_;
     GridOptions options_;
 };
@@ -153,6 +155,9 @@ BrickVolume GridModel::buildRates(const Light& light) const {
             const auto* diag = tensor ? grid_.tensorDiag->tree().probeConstLeaf(origin) : nullptr;
             const auto* offDiag =
                 tensor ? grid_.tensorOffDiag->tree().probeConstLeaf(origin) : nullptr;
+            std::array<const LeafT*, kMaxFiberTypes> fraction{};
+            for (std::size_t t = 0; t < grid_.typeFraction.size(); ++t)
+                fraction[t] = grid_.typeFraction[t]->tree().probeConstLeaf(origin);
             const BrickVolume::BrickSet bricks = volume.brickSet(brickOf(leaf));
             for (auto it = leaf.cbeginValueOn(); it; ++it) {
                 const openvdb::Index i = it.pos();
@@ -161,8 +166,18 @@ BrickVolume GridModel::buildRates(const Light& light) const {
                                    offDiag ? vec(offDiag->getValue(i)) : Vec3f(0.0f)};
                 const openvdb::Coord c = it.getCoord();
                 const Vec3f world = Vec3f(float(c.x()), float(c.y()), float(c.z())) * float(h);
-                const CrossingTable::Rates r = expectedRates(fibers, light.pathFrom(world).omega,
-                                                             crossings_, options_.orientation);
+                const Vec3f omega = light.pathFrom(world).omega;
+                // Several fiber types: their rates mixed by the voxel's fractions.
+                CrossingTable::Rates r;
+                if (grid_.typeFraction.empty()) {
+                    r = expectedRates(fibers, omega, crossings_[0], options_.orientation);
+                } else {
+                    for (std::size_t t = 0; t < grid_.typeFraction.size(); ++t)
+                        if (const float f = fraction[t] ? fraction[t]->getValue(i) : 0.0f; f > 0)
+                            r += expectedRates(fibers, omega, crossings_[t],
+                                               options_.orientation) *
+                                 f;
+                }
                 const float scale = fibers.lambda * kD;
                 const openvdb::Coord l = c - origin;
                 volume.set(bricks, {l.x(), l.y(), l.z()},
@@ -224,9 +239,9 @@ private:
         const float d_f = model_.settings().dualScattering.d_f;
         if (model_.mode() == GlobalTermMode::Grid)
             return globalTermFromDepths(d.n, d.tauP, d.sumBeta2, d_f);
-        // approx: every fiber in front shares the shading point's orientation.
+        // approx: every fiber in front shares the shading point's orientation and type.
         const float s = glm::dot(path.omega, q.tangent);
-        const CrossingTable::Values x = model_.crossings().crossing(s);
+        const CrossingTable::Values x = model_.crossings(q.fiberType).crossing(s);
         const Rgb perCrossing = model_.options().estimator == AttenuationEstimator::Poisson
                                     ? Rgb(1.0f) - exp(x.logABar_f)
                                     : -x.logABar_f;
@@ -249,22 +264,24 @@ std::unique_ptr<LightGlobalTerm> GridModel::forLight(const Light& light) const {
 
 } // namespace
 
-std::unique_ptr<GlobalTermModel> makeGridModel(const FiberGrid& grid,
-                                               const CrossingTable& crossings,
+std::unique_ptr<GlobalTermModel> makeGridModel(const FiberGrid& grid, CrossingTables crossings,
                                                const GlobalTermSettings& settings,
                                                const GridOptions& options) {
     settings.validate();
     options.validate(grid);
-    return std::make_unique<GridModel>(GlobalTermMode::Grid, grid, crossings, settings, options);
+    checkCrossingTables(crossings, grid.fiberTypeCount());
+    return std::make_unique<GridModel>(GlobalTermMode::Grid, grid, std::move(crossings), settings,
+                                       options);
 }
 
-std::unique_ptr<GlobalTermModel> makeApproxModel(const FiberGrid& grid,
-                                                 const CrossingTable& crossings,
+std::unique_ptr<GlobalTermModel> makeApproxModel(const FiberGrid& grid, CrossingTables crossings,
                                                  const GlobalTermSettings& settings,
                                                  const GridOptions& options) {
     settings.validate();
     options.validate(grid);
-    return std::make_unique<GridModel>(GlobalTermMode::Approx, grid, crossings, settings, options);
+    checkCrossingTables(crossings, grid.fiberTypeCount());
+    return std::make_unique<GridModel>(GlobalTermMode::Approx, grid, std::move(crossings),
+                                       settings, options);
 }
 
 } // namespace hairvox

@@ -37,7 +37,8 @@ std::vector<GlobalTermQuery> sampleFiberPoints(const Groom& groom, std::size_t c
             static_cast<std::ptrdiff_t>(cumulative.size()) - 1));
         const Vec3f a = groom.points[segmentStart[seg]], b = groom.points[segmentStart[seg] + 1];
         const float t = rng.uniformFloat();
-        points.push_back({lerp(t, a, b), normalizeOr(b - a, Vec3f(0, 1, 0)), segmentStrand[seg]});
+        points.push_back({lerp(t, a, b), normalizeOr(b - a, Vec3f(0, 1, 0)), segmentStrand[seg],
+                          true, fiberTypeAt(groom, segmentStart[seg])});
     }
     return points;
 }

@@ -1,7 +1,8 @@
 // hairvox voxelize: the fiber grid as a .vdb file (fiber_grid.h).
 //
 // One file holds the grids "density", "orientation" and optionally
-// "tensorDiag" and "tensorOffDiag"; every grid carries FiberGridInfo as grid
+// "tensorDiag" and "tensorOffDiag", and "fiberType0", "fiberType1", ... for a
+// groom of several fiber types; every grid carries FiberGridInfo as grid
 // metadata, so a grid copied out of the file alone keeps its provenance and
 // `vdb_print -l` or pyopenvdb show it. Counts are stored as int64 (the widest
 // integer pyopenvdb reads). Each grid also says what it holds: string
@@ -63,6 +64,14 @@ void addMetadata(openvdb::GridBase& grid, const FiberGridInfo& info) {
          "off-diagonal of the orientation tensor E[u u^T] (symmetric: yx = xy, zx = xz, zy = yz)",
          "xy,xz,yz"},
     };
+    if (grid.getName().starts_with("fiberType")) {
+        grid.setGridClass(openvdb::GRID_UNKNOWN);
+        grid.insertMeta("units", openvdb::StringMetadata("dimensionless, [0, 1]"));
+        grid.insertMeta("description",
+                        openvdb::StringMetadata(
+                            "fraction of the voxel's (diameter-weighted) fiber length of this "
+                            "fiber type; the types' fractions sum to 1; background 0"));
+    }
     for (const Meaning& m : kMeanings) {
         if (grid.getName() != m.name)
             continue;
@@ -159,6 +168,10 @@ bool finiteVec(const openvdb::Vec3s& v) {
 
 } // namespace
 
+std::string typeFractionGridName(std::size_t type) {
+    return strCat("fiberType", type);
+}
+
 void writeFiberGrid(const std::filesystem::path& path, const FiberGrid& grid) {
     if (!grid.density || !grid.orientation)
         throw std::invalid_argument(
@@ -166,9 +179,10 @@ void writeFiberGrid(const std::filesystem::path& path, const FiberGrid& grid) {
     openvdb::initialize();
     // Shallow copies (shared trees) carry the metadata, leaving the caller's grids untouched.
     openvdb::GridPtrVec grids;
-    for (const openvdb::GridBase::Ptr& g :
-         {openvdb::GridBase::Ptr(grid.density), openvdb::GridBase::Ptr(grid.orientation),
-          openvdb::GridBase::Ptr(grid.tensorDiag), openvdb::GridBase::Ptr(grid.tensorOffDiag)}) {
+    std::vector<openvdb::GridBase::Ptr> all{
+        grid.density, grid.orientation, grid.tensorDiag, grid.tensorOffDiag};
+    all.insert(all.end(), grid.typeFraction.begin(), grid.typeFraction.end());
+    for (const openvdb::GridBase::Ptr& g : all) {
         if (!g)
             continue;
         openvdb::GridBase::Ptr copy = g->copyGrid();
@@ -202,6 +216,13 @@ FiberGrid readFiberGrid(const std::filesystem::path& path) {
         grid.orientation = readGrid<openvdb::Vec3SGrid>(in, kOrientationGridName, file);
         grid.tensorDiag = readGrid<openvdb::Vec3SGrid>(in, kTensorDiagGridName, file);
         grid.tensorOffDiag = readGrid<openvdb::Vec3SGrid>(in, kTensorOffDiagGridName, file);
+        for (std::size_t t = 0; t < kMaxFiberTypes; ++t) {
+            const std::string name = typeFractionGridName(t);
+            auto fraction = readGrid<openvdb::FloatGrid>(in, name.c_str(), file);
+            if (!fraction)
+                break;
+            grid.typeFraction.push_back(std::move(fraction));
+        }
         in.close();
         if (!grid.density || !grid.orientation)
             throw InputError(strCat(file, ": a fiber grid needs the grids '", kDensityGridName,
@@ -223,6 +244,15 @@ FiberGrid readFiberGrid(const std::filesystem::path& path) {
             checkTransform(*grid.tensorOffDiag, h, file);
             checkValues(*grid.tensorDiag, file, "finite", finiteVec);
             checkValues(*grid.tensorOffDiag, file, "finite", finiteVec);
+        }
+        if (grid.typeFraction.size() == 1)
+            throw InputError(strCat(file, ": a single fiber-type fraction grid '",
+                                    typeFractionGridName(0),
+                                    "'; fractions come for 2 types or more"));
+        for (const auto& fraction : grid.typeFraction) {
+            checkTransform(*fraction, h, file);
+            checkValues(*fraction, file, "in [0, 1]",
+                        [](float v) { return v >= 0 && v <= 1; });
         }
     } catch (const openvdb::Exception& e) {
         throw InputError(strCat(file, ": cannot read as a hairvox fiber grid: ", e.what()));

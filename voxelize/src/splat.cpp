@@ -321,52 +321,63 @@ BrickBuckets bucketSegments(const Groom& groom, const std::vector<StrandRange>& 
 // ---------------------------------------------------------------------------
 // The per-brick accumulator.
 
-/// Channels per voxel: ∫w ds, ∫w u ds (3) and, with the tensor, ∫w u uᵀ ds (6).
-template <bool Tensor>
-constexpr std::size_t kChannels = Tensor ? 10 : 4;
+/// Channels per voxel: ∫w ds, ∫w u ds (3), with the tensor ∫w u uᵀ ds (6),
+/// and for a typed groom ∫w [type = t] ds for each fiber type t.
+template <bool Tensor, bool Typed>
+struct Channels {
+    static constexpr std::size_t kTensorDiag = 4, kTensorOffDiag = 7;
+    static constexpr std::size_t kType = Tensor ? 10 : 4;
+    static constexpr std::size_t C = kType + (Typed ? kMaxFiberTypes : 0);
 
-/// The per-segment values splatted with the weights: 1, u and (with the tensor) u uᵀ.
-template <std::size_t C>
-std::array<double, C> channelValues(const Vec3d& u) {
-    std::array<double, C> v;
-    v[0] = 1;
-    v[1] = u.x;
-    v[2] = u.y;
-    v[3] = u.z;
-    if constexpr (C == 10) {
-        v[4] = u.x * u.x;
-        v[5] = u.y * u.y;
-        v[6] = u.z * u.z;
-        v[7] = u.x * u.y;
-        v[8] = u.x * u.z;
-        v[9] = u.y * u.z;
+    /// The per-segment values splatted with the weights: 1, u, u uᵀ, and the
+    /// one-hot fiber type.
+    static std::array<double, C> values(const Vec3d& u, std::uint8_t type) {
+        std::array<double, C> v{};
+        v[0] = 1;
+        v[1] = u.x;
+        v[2] = u.y;
+        v[3] = u.z;
+        if constexpr (Tensor) {
+            v[kTensorDiag] = u.x * u.x;
+            v[kTensorDiag + 1] = u.y * u.y;
+            v[kTensorDiag + 2] = u.z * u.z;
+            v[kTensorOffDiag] = u.x * u.y;
+            v[kTensorOffDiag + 1] = u.x * u.z;
+            v[kTensorOffDiag + 2] = u.y * u.z;
+        }
+        if constexpr (Typed)
+            v[kType + type] = 1;
+        return v;
     }
-    return v;
-}
+};
 
 /// The leaves one brick produces.
 struct BrickLeaves {
     std::vector<std::unique_ptr<FloatLeaf>> density;
     std::vector<std::unique_ptr<Vec3SLeaf>> orientation, tensorDiag, tensorOffDiag;
+    std::array<std::vector<std::unique_ptr<FloatLeaf>>, kMaxFiberTypes> typeFraction;
 };
 
 /// Dense double sums over one brick and its apron, z fastest (OpenVDB's leaf
 /// order). Coordinates are local: local 0 is voxel (brick origin − 1).
-template <bool Tensor>
+template <bool Tensor, bool Typed>
 class BrickAccumulator {
 public:
-    static constexpr std::size_t C = kChannels<Tensor>;
+    using Ch = Channels<Tensor, Typed>;
+    static constexpr std::size_t C = Ch::C;
     static_assert(C % 2 == 0, "channels are updated in pairs");
     static_assert(kLeavesPerBrickSide * kLeavesPerBrickSide * kLeavesPerBrickSide <= 64,
                   "touchedLeaves_ has one bit per leaf");
 
-    BrickAccumulator()
-        : sums_(std::size_t(kAccDim) * kAccDim * kAccDim * C, 0.0) {}
+    /// `fiberTypes`: how many type fractions to emit (Typed only).
+    explicit BrickAccumulator(std::size_t fiberTypes)
+        : sums_(std::size_t(kAccDim) * kAccDim * kAccDim * C, 0.0)
+        , fiberTypes_(fiberTypes) {}
 
-    /// Adds segment s (in local index space) of world length `length` and
-    /// unit tangent u, clipped to the cells that touch the brick's voxels:
-    /// local cells [0, 32], i.e. the box [0, 33]³.
-    void addSegment(const IndexSegment& s, double length, const Vec3d& u) {
+    /// Adds segment s (in local index space) of weighted world length
+    /// `length`, unit tangent u and fiber type `type`, clipped to the cells
+    /// that touch the brick's voxels: local cells [0, 32], i.e. the box [0, 33]³.
+    void addSegment(const IndexSegment& s, double length, const Vec3d& u, std::uint8_t type) {
         double t0 = 0, t1 = 1;
         for (int i = 0; i < 3; ++i) {
             constexpr double lo = 0, hi = kBrickSize + 1;
@@ -384,7 +395,7 @@ public:
         if (!(t0 < t1))
             return;
 
-        const std::array<double, C> values = channelValues<C>(u);
+        const std::array<double, C> values = Ch::values(u, type);
         std::array<Double2, C / 2> channel;
         for (std::size_t j = 0; j < C / 2; ++j)
             channel[j] = Double2{values[2 * j], values[2 * j + 1]};
@@ -499,6 +510,7 @@ private:
                      BrickLeaves& out) {
         std::unique_ptr<FloatLeaf> density;
         std::unique_ptr<Vec3SLeaf> orientation, diag, offDiag;
+        std::array<std::unique_ptr<FloatLeaf>, kMaxFiberTypes> fraction;
         for (int x = 0; x < kLeafDim; ++x)
             for (int y = 0; y < kLeafDim; ++y)
                 for (int z = 0; z < kLeafDim; ++z) {
@@ -517,6 +529,9 @@ private:
                             offDiag =
                                 std::make_unique<Vec3SLeaf>(origin, openvdb::Vec3s(0.0f), false);
                         }
+                        if constexpr (Typed)
+                            for (std::size_t t = 0; t < fiberTypes_; ++t)
+                                fraction[t] = std::make_unique<FloatLeaf>(origin, 0.0f, false);
                     }
                     const openvdb::Index offset =
                         FloatLeaf::coordToOffset(origin + openvdb::Coord(x, y, z));
@@ -529,9 +544,13 @@ private:
                     density->setValueOn(offset, lambda);
                     orientation->setValueOn(offset, mean(1));
                     if constexpr (Tensor) {
-                        diag->setValueOn(offset, mean(4));
-                        offDiag->setValueOn(offset, mean(7));
+                        diag->setValueOn(offset, mean(Ch::kTensorDiag));
+                        offDiag->setValueOn(offset, mean(Ch::kTensorOffDiag));
                     }
+                    if constexpr (Typed)
+                        for (std::size_t t = 0; t < fiberTypes_; ++t)
+                            fraction[t]->setValueOn(
+                                offset, static_cast<float>(v[Ch::kType + t] * inv));
                 }
         if (!density)
             return;
@@ -541,6 +560,9 @@ private:
             out.tensorDiag.push_back(std::move(diag));
             out.tensorOffDiag.push_back(std::move(offDiag));
         }
+        if constexpr (Typed)
+            for (std::size_t t = 0; t < fiberTypes_; ++t)
+                out.typeFraction[t].push_back(std::move(fraction[t]));
     }
 
     static int leafBit(int x, int y, int z) {
@@ -558,21 +580,25 @@ private:
     }
 
     std::vector<double> sums_;
+    std::size_t fiberTypes_;
     std::uint64_t touchedLeaves_ = 0; ///< leaves marked since the last extract, by leafBit()
 };
 
-template <bool Tensor>
+template <bool Tensor, bool Typed>
 std::vector<BrickLeaves> splatBricks(const Groom& groom, const BrickBuckets& buckets, double h,
+                                     const FiberScale& scale, std::size_t fiberTypes,
                                      bool threaded, ProgressReporter& progress) {
     const double invH = 1.0 / h, invVoxelVolume = 1.0 / (h * h * h);
+    const bool perPointDiameter = !groom.thickness.empty();
+    const double invWidth = 1.0 / double(scale.ribbonWidth());
     std::vector<BrickLeaves> leaves(buckets.bricks.size());
-    tbb::enumerable_thread_specific<std::unique_ptr<BrickAccumulator<Tensor>>> accumulators;
+    tbb::enumerable_thread_specific<std::unique_ptr<BrickAccumulator<Tensor, Typed>>> accumulators;
     forEachIndexInOrder(buckets.bricks.size(), threaded, [&](std::size_t k) {
         throwIfInterrupted();
         const std::uint32_t b = buckets.largestFirst[k];
         auto& acc = accumulators.local();
         if (!acc)
-            acc = std::make_unique<BrickAccumulator<Tensor>>();
+            acc = std::make_unique<BrickAccumulator<Tensor, Typed>>(fiberTypes);
         const BrickKey& key = buckets.bricks[b];
         const openvdb::Coord origin(key.x * kBrickSize, key.y * kBrickSize, key.z * kBrickSize);
         const Vec3d base = Vec3d(origin.x(), origin.y(), origin.z()) - 1.0;
@@ -587,9 +613,16 @@ std::vector<BrickLeaves> splatBricks(const Groom& groom, const BrickBuckets& buc
                 p1 = Vec3d(groom.points[p]);
                 const Vec3d delta = p1 - p0;
                 const double length = glm::length(delta);
-                if (length > 0)
-                    acc->addSegment(IndexSegment(p0 * invH - base, delta * invH), length,
-                                    delta * (1.0 / length));
+                // A segment of mean diameter D̄ counts as D̄/D fibers of diameter D
+                // (its width is linear between its points: ribbonWidthAt()).
+                const double weight =
+                    perPointDiameter ? 0.5 * invWidth *
+                                           (double(ribbonWidthAt(groom, scale, p - 1)) +
+                                            double(ribbonWidthAt(groom, scale, p)))
+                                     : 1.0;
+                if (length > 0 && weight > 0)
+                    acc->addSegment(IndexSegment(p0 * invH - base, delta * invH), length * weight,
+                                    delta * (1.0 / length), fiberTypeAt(groom, p - 1));
             }
         }
         acc->extract(origin, invVoxelVolume, leaves[b]);
@@ -608,9 +641,12 @@ struct GroomScan {
     double totalLength = 0;
     Vec3d sumAbsDelta{0.0};                         ///< Σ over segments of |Δx|, |Δy|, |Δz|
     std::size_t badStrand = SIZE_MAX, badPoint = 0; ///< first non-finite point
+    double maxWidthRatio = 1; ///< largest D_i/D (per-point diameters)
+    std::size_t fiberTypes = 1; ///< 1 + the largest fiber type
 };
 
-GroomScan scanGroom(const Groom& groom, const std::vector<StrandRange>& chunks, bool threaded) {
+GroomScan scanGroom(const Groom& groom, const std::vector<StrandRange>& chunks,
+                    const FiberScale& scale, bool threaded) {
     std::vector<GroomScan> perChunk(chunks.size());
     forEachIndex(chunks.size(), threaded, [&](std::size_t c) {
         GroomScan& scan = perChunk[c];
@@ -624,6 +660,11 @@ GroomScan scanGroom(const Groom& groom, const std::vector<StrandRange>& chunks, 
                     break;
                 }
                 scan.bounds.extend(pts[k]);
+                if (!groom.thickness.empty())
+                    scan.maxWidthRatio = std::max(
+                        scan.maxWidthRatio,
+                        double(ribbonWidthAt(groom, scale, groom.strandStart[s] + k)) /
+                            double(scale.ribbonWidth()));
                 if (k > 0) {
                     const Vec3d delta = Vec3d(pts[k]) - Vec3d(pts[k - 1]);
                     scan.totalLength += glm::length(delta);
@@ -641,7 +682,13 @@ GroomScan scanGroom(const Groom& groom, const std::vector<StrandRange>& chunks, 
         total.bounds.extend(s.bounds);
         total.totalLength += s.totalLength;
         total.sumAbsDelta += s.sumAbsDelta;
+        total.maxWidthRatio = std::max(total.maxWidthRatio, s.maxWidthRatio);
     }
+    total.fiberTypes = fiberTypeCount(groom);
+    if (total.fiberTypes > kMaxFiberTypes)
+        throw InputError(strCat("voxelize: the groom has fiber type ", total.fiberTypes - 1,
+                                "; at most ", kMaxFiberTypes, " types (0 to ",
+                                kMaxFiberTypes - 1, ") are supported"));
     return total;
 }
 
@@ -658,13 +705,17 @@ double voxelSizeFromBounds(const Bounds3f& bounds, int voxelsAcross) {
 /// for the bricks above that need a brick's last layer) and the accumulators.
 double memoryForLeaves(double leaves, const Groom& groom, const GroomScan& scan, double h,
                        bool tensor, bool threaded) {
+    const bool typed = scan.fiberTypes > 1;
     const double leafBytes =
-        double(sizeof(FloatLeaf) + FloatLeaf::SIZE * sizeof(float)) +
+        double(1 + (typed ? scan.fiberTypes : 0)) *
+            double(sizeof(FloatLeaf) + FloatLeaf::SIZE * sizeof(float)) +
         double(tensor ? 3 : 1) *
             double(sizeof(Vec3SLeaf) + Vec3SLeaf::SIZE * sizeof(openvdb::Vec3s));
     const double l1 = scan.sumAbsDelta.x + scan.sumAbsDelta.y + scan.sumAbsDelta.z;
     const double runs = 2.0 * (double(groom.strandCount()) + l1 / (h * kBrickSize));
-    const double accumulatorBytes = double(kAccDim) * kAccDim * kAccDim * (tensor ? 10 : 4) * 8;
+    const double channels = double(tensor ? Channels<true, false>::C : Channels<false, false>::C) +
+                            (typed ? double(kMaxFiberTypes) : 0.0);
+    const double accumulatorBytes = double(kAccDim) * kAccDim * kAccDim * channels * 8;
     const double threads = threaded ? std::max(1, activeThreadCount()) : 1;
     return leaves * leafBytes + runs * double(sizeof(ChunkRuns::Entry) + sizeof(Run)) +
            threads * accumulatorBytes;
@@ -741,8 +792,8 @@ void checkVoxelSizeForGroom(const Groom& groom, const std::vector<StrandRange>& 
                                 " at voxel index ", reach / h,
                                 ", beyond OpenVDB's 32-bit index space (limit ", kMaxIndex,
                                 "); use a larger voxel size"));
-    // λ ≤ total length / h³ anywhere; it must fit a float.
-    if (!(scan.totalLength / (h * h * h) < double(FLT_MAX)))
+    // λ ≤ total length · max D_i/D / h³ anywhere; it must fit a float.
+    if (!(scan.totalLength * scan.maxWidthRatio / (h * h * h) < double(FLT_MAX)))
         throw InputError(strCat("voxelize: voxel size ", h,
                                 " is too small: the length density would overflow a float"));
 
@@ -796,7 +847,7 @@ FiberGrid splatStrands(const Groom& groom, const SplatOptions& options) {
         hashing.run([&] { hash = contentHash(groom); });
     else
         hash = contentHash(groom);
-    const GroomScan scan = scanGroom(groom, chunks, options.threaded);
+    const GroomScan scan = scanGroom(groom, chunks, options.fiberScale, options.threaded);
     hashing.wait();
     const double defaultH = voxelSizeFromBounds(scan.bounds, kDefaultVoxelsAcross);
     const double h = options.voxelSize > 0 ? options.voxelSize : defaultH;
@@ -827,6 +878,13 @@ FiberGrid splatStrands(const Groom& groom, const SplatOptions& options) {
         grid.tensorDiag = makeGrid<openvdb::Vec3SGrid>(kTensorDiagGridName, h);
         grid.tensorOffDiag = makeGrid<openvdb::Vec3SGrid>(kTensorOffDiagGridName, h);
     }
+    const bool typed = scan.fiberTypes > 1;
+    if (typed)
+        for (std::size_t t = 0; t < scan.fiberTypes; ++t) {
+            grid.typeFraction.push_back(
+                makeGrid<openvdb::FloatGrid>(typeFractionGridName(t).c_str(), h));
+            grid.typeFraction.back()->setGridClass(openvdb::GRID_UNKNOWN);
+        }
     if (!hasLength) {
         grid.warnings.emplace_back(groom.empty()
                                        ? "the groom is empty; the fiber grid is empty"
@@ -837,9 +895,13 @@ FiberGrid splatStrands(const Groom& groom, const SplatOptions& options) {
     const double invH = 1.0 / h;
     const BrickBuckets buckets = bucketSegments(groom, chunks, invH, options.threaded);
     ProgressReporter progress("voxelize", buckets.bricks.size(), options.showProgress);
+    const auto splat = [&]<bool Tensor, bool Typed>() {
+        return splatBricks<Tensor, Typed>(groom, buckets, h, options.fiberScale, scan.fiberTypes,
+                                          options.threaded, progress);
+    };
     std::vector<BrickLeaves> leaves =
-        tensor ? splatBricks<true>(groom, buckets, h, options.threaded, progress)
-               : splatBricks<false>(groom, buckets, h, options.threaded, progress);
+        tensor ? (typed ? splat.operator()<true, true>() : splat.operator()<true, false>())
+               : (typed ? splat.operator()<false, true>() : splat.operator()<false, false>());
     progress.finish();
     for (BrickLeaves& b : leaves) {
         addLeaves(*grid.density, b.density);
@@ -848,6 +910,8 @@ FiberGrid splatStrands(const Groom& groom, const SplatOptions& options) {
             addLeaves(*grid.tensorDiag, b.tensorDiag);
             addLeaves(*grid.tensorOffDiag, b.tensorOffDiag);
         }
+        for (std::size_t t = 0; t < grid.typeFraction.size(); ++t)
+            addLeaves(*grid.typeFraction[t], b.typeFraction[t]);
     }
     return grid;
 }
@@ -862,6 +926,8 @@ std::uint64_t FiberGrid::memoryBytes() const {
              density.get(), orientation.get(), tensorDiag.get(), tensorOffDiag.get()})
         if (g)
             bytes += g->memUsage();
+    for (const auto& g : typeFraction)
+        bytes += g->memUsage();
     return bytes;
 }
 
@@ -874,7 +940,8 @@ std::ostream& operator<<(std::ostream& os, const FiberGridInfo& info) {
 
 std::ostream& operator<<(std::ostream& os, const FiberGrid& grid) {
     return os << "FiberGrid(" << grid.info << ", activeVoxels=" << grid.activeVoxelCount()
-              << ", tensor=" << (grid.hasTensor() ? "yes" : "no") << ")";
+              << ", tensor=" << (grid.hasTensor() ? "yes" : "no")
+              << ", fiberTypes=" << grid.fiberTypeCount() << ")";
 }
 
 std::ostream& operator<<(std::ostream& os, const SplatOptions& o) {

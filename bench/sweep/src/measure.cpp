@@ -42,8 +42,7 @@ std::vector<std::vector<GlobalTerm>> probeTerms(Scene scene, const PipelineOptio
 }
 
 std::vector<GlobalTermQuery> probePointsOf(const Scene& scene, const BenchJob& job, double* h0) {
-    std::string warnings;
-    const Groom groom = loadGroom(scene, warnings);
+    const Groom groom = loadGroom(scene).groom;
     if (h0)
         *h0 = scene.voxelSize ? double(*scene.voxelSize) : defaultVoxelSize(groom);
     return sampleFiberPoints(groom, job.probePoints, job.probeSeed);

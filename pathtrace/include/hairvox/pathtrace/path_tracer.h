@@ -81,7 +81,9 @@ namespace hairvox {
 struct PathTraceScene {
     const Groom* groom = nullptr;
     FiberScale fiberScale;
-    FiberParams fiber;
+    /// The fiber of each fiber type (Groom::fiberType); a fiber scatters with
+    /// its segment's. At least one.
+    std::vector<FiberParams> fibers{FiberParams{}};
     std::vector<Light> lights;
     CameraParams camera;
     /// The opaque surfaces (null: none) and each one's Lambertian albedo, in

@@ -102,20 +102,27 @@ struct SceneSurfaces {
 /// for a mesh that cannot be used.
 SceneSurfaces loadSurfaces(const Scene& scene);
 
+/// The scene's groom, generated or read from its file, with its per-point
+/// attributes resolved (groom_attributes.h): groom.thickness holds diameters
+/// in scene units, groom.fiberType indexes `palette`.
+struct SceneGroom {
+    Groom groom;
+    FiberPalette palette;
+    std::vector<std::string> warnings; ///< dropped segments, attributes not rendered, ...
+    std::vector<std::string> notes;    ///< what was taken from the file's attributes
+};
+
+SceneGroom loadGroom(const Scene& scene);
+
 /// Everything a scene's global term is computed from.
 struct SceneAssets {
-    Groom groom;
-    std::string groomWarnings;     ///< dropped segments etc., for the user
+    SceneGroom groom;
     SceneSurfaces surfaces;
     std::optional<FiberGrid> grid; ///< present in the grid and approx modes
-    std::unique_ptr<DualScatteringTables> tables;
+    std::vector<DualScatteringTables> tables;    ///< per fiber type (groom.palette)
     std::unique_ptr<GlobalTermModel> globalTerm; ///< refers to `grid`: keep the assets together
     StageTimes times;                            ///< load, voxelize, tables
 };
-
-/// The scene's groom: generated, or read from its file. `warnings` receives
-/// what the reader dropped (empty when nothing).
-Groom loadGroom(const Scene& scene, std::string& warnings);
 
 /// Loads or generates the scene's groom and builds what its global-term mode needs.
 /// The result must not be moved while globalTerm is in use (it refers to grid).
@@ -145,6 +152,8 @@ struct SceneRender {
     std::uint64_t activeVoxels = 0; ///< of the fiber grid (0 in exact mode)
     std::uint64_t surfaceTriangles = 0; ///< of the scene's meshes
     double voxelSize = 0;
+    std::size_t fiberTypes = 1;         ///< of the groom (SceneGroom::palette)
+    std::vector<std::string> groomNotes; ///< SceneGroom::notes, for the report
 };
 
 /// Renders the scene end to end and writes its outputs (unless writeFiles is
@@ -172,10 +181,12 @@ std::vector<std::string> hairRadianceLayers(const Film& film);
 /// of it where the film has one: what the dual-scattering model is judged on.
 ComparedImage hairRadianceOf(const Film& film);
 
-/// What a path trace's samples depend on (groom content, fiber scale and
-/// optics, lights, camera, surfaces and their content, background, seed, depth settings): the key
-/// under which a run may continue another.
-std::string pathTraceHash(const Scene& scene, const Groom& groom, const SceneSurfaces& surfaces);
+/// What a path trace's samples depend on (groom content with its per-point
+/// diameters and fiber types, fiber scale, each fiber type's optics, lights,
+/// camera, surfaces and their content, background, seed, depth settings): the
+/// key under which a run may continue another.
+std::string pathTraceHash(const Scene& scene, const SceneGroom& groom,
+                          const SceneSurfaces& surfaces);
 
 /// The closing report: time per stage and what was skipped.
 void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& render);

@@ -20,6 +20,7 @@
 #include <hairvox/geometry/light.h>
 #include <hairvox/geometry/triangle_mesh.h>
 #include <hairvox/pathtrace/path_tracer.h>
+#include <hairvox/pipeline/groom_attributes.h>
 #include <hairvox/render/fragment_shader.h>
 #include <hairvox/shading/fiber_params.h>
 #include <hairvox/strands/fiber_scale.h>
@@ -43,6 +44,10 @@ struct GroomSource {
     /// .hair/.tfx/.obj, resolved against the scene file's directory; empty → procedural.
     std::filesystem::path file;
     ProceduralGroomParams procedural;
+    /// How the file's per-point thickness is read (groom_attributes.h).
+    GroomThickness thickness = GroomThickness::Auto;
+    /// Whether the file's per-point colours set the fibers' σ_a (groom_attributes.h).
+    GroomColor color = GroomColor::Use;
 
     bool isProcedural() const { return file.empty(); }
 };

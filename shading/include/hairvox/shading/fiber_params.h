@@ -29,6 +29,19 @@ struct FiberParams {
     /// σ_a from melanin concentrations as in pbrt-v3/v4:
     /// c_eu·(0.419, 0.697, 1.37) + c_pheo·(0.187, 0.4, 1.05).
     static Rgb sigmaFromMelanin(float eumelanin, float pheomelanin);
+    /// σ_a from the colour c a dense mass of these fibers should show: the
+    /// inverse of the multiple-scattering albedo fitted by Chiang et al. 2016
+    /// (Eq. 9), per channel σ_a = (ln c / f(β_n))² with
+    /// f(β_n) = 5.969 − 0.215β_n + 2.532β_n² − 10.73β_n³ + 5.574β_n⁴ + 0.245β_n⁵
+    /// at β_n = kColorRoughness (pbrt-v4's default azimuthal roughness: the
+    /// Marschner fiber has no β_n; its smooth azimuthal lobes are closest to
+    /// this). The fit is for σ_a per unit radius with path length 2cos γ_t /
+    /// cos θ_t through the fiber, our convention. c = 1 gives σ_a = 0; each
+    /// channel is clamped to [kMinColor, 1] first, so σ_a stays within the
+    /// valid range (σ_a ≤ 22 at c = 1e-12).
+    static Rgb sigmaFromColor(const Rgb& color);
+    static constexpr float kColorRoughness = 0.3f;
+    static constexpr float kMinColor = 1e-12f;
 
     /// Throws InputError naming the first parameter outside its range (given above).
     void validate() const;

@@ -80,10 +80,30 @@ inline float ribbonWidthAt(const Groom& groom, const FiberScale& scale, std::siz
                                    : groom.thickness[point] * scale.densityMultiplier;
 }
 
-/// The fiber type of the segment starting at `point` (0 when the groom has none).
-inline std::uint8_t fiberTypeAt(const Groom& groom, std::size_t point) {
-    return groom.fiberType.empty() ? 0 : groom.fiberType[point];
+/// The largest ribbonWidthAt() over the groom's points (k·D without per-point diameters).
+float maxRibbonWidth(const Groom& groom, const FiberScale& scale);
+
+/// At most this many fiber types (the fiber grid splats one fraction per type).
+inline constexpr std::size_t kMaxFiberTypes = 8;
+
+/// The point a segment starts at: in a sanitized groom, global segment s of
+/// strand i (segments numbered consecutively, strand by strand) starts at
+/// point s + i.
+inline std::size_t segmentStartPoint(std::uint32_t strand, std::uint32_t segment) {
+    return std::size_t(segment) + strand;
 }
+
+/// The fiber type of the segment starting at `point`, from a groom's
+/// fiberType array (0 when it is empty: an untyped groom).
+inline std::uint8_t fiberTypeAt(std::span<const std::uint8_t> fiberType, std::size_t point) {
+    return fiberType.empty() ? 0 : fiberType[point];
+}
+inline std::uint8_t fiberTypeAt(const Groom& groom, std::size_t point) {
+    return fiberTypeAt(groom.fiberType, point);
+}
+
+/// 1 + the largest fiber type of the groom (1 for an untyped groom).
+std::size_t fiberTypeCount(const Groom& groom);
 
 /// Summary figures printed by `hairvox info` and recorded as grid metadata.
 struct GroomStats {

@@ -80,4 +80,12 @@ private:
     Rates isotropic_;
 };
 
+/// One table per fiber type, indexed by Groom::fiberType (strands/groom.h);
+/// a single table for an untyped groom.
+using CrossingTables = std::vector<CrossingTable>;
+
+/// Throws InputError unless there is a table for each of `fiberTypes` types.
+void checkCrossingTables(const CrossingTables& tables, std::size_t fiberTypes);
+
+
 } // namespace hairvox

@@ -11,7 +11,8 @@
 //   V = [m = 0],  P = ∏ ā_f(θ_j),  σ_f² = Σ β̄_f²(θ_j),  T_s = d_f (P − V).
 // With K rays whose origins are spread over a disk of radius r perpendicular
 // to the light, the global term is the mean over rays (σ_f² over the rays that
-// crossed something, matching the grid's conditioning).
+// crossed something, matching the grid's conditioning). A crossing takes ā_f and
+// β̄_f² of its own segment's fiber type (Groom::fiberType).
 //
 // Self-shadowing: the query point lies on its own fiber, which must not count.
 // The own strand is the query's strand hint or else the strand whose
@@ -36,9 +37,9 @@ struct ExactOptions {
     void validate() const;
 };
 
-/// The `exact` mode. Keeps a reference to nothing: the groom is copied into
-/// the Embree scene.
-std::unique_ptr<GlobalTermModel> makeExactModel(const Groom& groom, const CrossingTable& crossings,
+/// The `exact` mode, with one crossing table per fiber type of the groom.
+/// Keeps a reference to nothing: the groom is copied into the Embree scene.
+std::unique_ptr<GlobalTermModel> makeExactModel(const Groom& groom, CrossingTables crossings,
                                                 const GlobalTermSettings& settings,
                                                 const ExactOptions& options);
 

@@ -35,6 +35,9 @@ struct GlobalTermQuery {
     Vec3f tangent;
     std::uint32_t strand = kUnknownStrand;
     bool onFiber = true;
+    /// The query's fiber type (Groom::fiberType): approx mode assumes the
+    /// fibers in front are of this type.
+    std::uint8_t fiberType = 0;
 };
 
 /// What a per-light evaluation skipped (DESIGN.md §7).

@@ -7,7 +7,9 @@
 //      or  λ_v·k·D·E_v[cos θ·(−ln ā_f(θ))]     (the paper's geometric form ā_f^n)
 //   Σβ²    λ_v·k·D·E_v[cos θ·β̄_f²(θ)]          → σ_f² = Σβ² / (1 − V)
 // with sin θ = ω·u over the fibers u in the voxel (the orientation model says
-// how E_v is estimated from what voxelize stored). The rates are reconstructed
+// how E_v is estimated from what voxelize stored). A grid of several fiber
+// types mixes the types' rates (ā_f and β̄_f² of each type's fiber) with the
+// voxel's type fractions f_t: rates = Σ_t f_t·rates_t. The rates are reconstructed
 // between voxels with the fiber grid's own trilinear convention, and a shadow
 // ray integrates them *exactly*: along a line the trilinear field is a cubic
 // polynomial within each cell, so Simpson's rule per cell crossing has no step
@@ -38,7 +40,8 @@
 // docs/DESIGN.md §8). 0.5 is the default.
 //
 // The `approx` mode (RenderMan report §2.1) uses the same march for n only and
-// assumes every fiber in front shares the shading point's orientation θ_x:
+// assumes every fiber in front shares the shading point's orientation θ_x
+// (and its fiber type):
 // P from n·(1 − ā_f(θ_x)) (or ā_f(θ_x)^n), Σβ² = n·β̄_f²(θ_x).
 #pragma once
 
@@ -107,16 +110,15 @@ struct GridOptions {
 
 std::ostream& operator<<(std::ostream& os, const GridOptions& options);
 
-/// The `grid` mode. The model keeps a reference to `grid`, which must outlive it
-/// and every LightGlobalTerm it returns.
-std::unique_ptr<GlobalTermModel> makeGridModel(const FiberGrid& grid,
-                                               const CrossingTable& crossings,
+/// The `grid` mode, with one crossing table per fiber type of the grid. The
+/// model keeps a reference to `grid`, which must outlive it and every
+/// LightGlobalTerm it returns.
+std::unique_ptr<GlobalTermModel> makeGridModel(const FiberGrid& grid, CrossingTables crossings,
                                                const GlobalTermSettings& settings,
                                                const GridOptions& options);
 
 /// The `approx` mode (same lifetime rule).
-std::unique_ptr<GlobalTermModel> makeApproxModel(const FiberGrid& grid,
-                                                 const CrossingTable& crossings,
+std::unique_ptr<GlobalTermModel> makeApproxModel(const FiberGrid& grid, CrossingTables crossings,
                                                  const GlobalTermSettings& settings,
                                                  const GridOptions& options);
 

@@ -45,6 +45,17 @@
 //   reconstruction of a per-fiber quantity g(u) at x is Σ_v w_v(x) λ_v E_v[g],
 //   i.e. interpolate λ·o (or λ·T) rather than λ and o separately.
 //
+// Per-point diameters and fiber types (strands/groom.h)
+// ------------------------------------------------------
+//   A segment of mean diameter D̄ (its points' D_i, groom.thickness) is
+//   splatted with weight D̄/D: λ counts fibers of the nominal diameter D, so
+//   the optical depth stays λ·k·D·|ω×u| and the statistics above are weighted
+//   by the cross-section a ray meets. A groom with several fiber types
+//   (Groom::fiberType) also gets, per type t, the fraction of the voxel's
+//   weighted length of that type, f_t = E_v[type = t] ∈ [0, 1], Σ_t f_t = 1
+//   (grids "fiberType<t>", sharing the density's topology); the global term
+//   mixes the types' rates with these weights.
+//
 // Voxels are active where λ is at least FLT_MIN; elsewhere every grid reads
 // its background 0. The fiber scale (diameter D, density multiplier k;
 // strands/fiber_scale.h) is recorded for the consumers (optical depth
@@ -56,6 +67,7 @@
 
 #include <openvdb/openvdb.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <ostream>
@@ -69,6 +81,8 @@ inline constexpr const char* kDensityGridName = "density";
 inline constexpr const char* kOrientationGridName = "orientation";
 inline constexpr const char* kTensorDiagGridName = "tensorDiag";
 inline constexpr const char* kTensorOffDiagGridName = "tensorOffDiag";
+/// "fiberType0", "fiberType1", ...: the fraction of fiber type t.
+std::string typeFractionGridName(std::size_t type);
 
 /// What a fiber grid was made from; stored as metadata on every grid of a .vdb
 /// (names in fiber_grid_io.cpp: voxel_size, fiber_diameter, density_multiplier,
@@ -93,11 +107,16 @@ struct FiberGrid {
     /// "tensorDiag", "tensorOffDiag": E[u uᵀ] as (xx, yy, zz) and (xy, xz, yz);
     /// both null when not stored (SplatOptions::storeOrientationTensor).
     openvdb::Vec3SGrid::Ptr tensorDiag, tensorOffDiag;
+    /// "fiberType<t>": f_t, the fraction of fiber type t (see above); one grid
+    /// per type for a groom with more than one type, empty otherwise.
+    std::vector<openvdb::FloatGrid::Ptr> typeFraction;
     FiberGridInfo info;
     /// Notes for the user from splatStrands (e.g. an empty groom); not stored in files.
     std::vector<std::string> warnings;
 
     bool hasTensor() const { return tensorDiag != nullptr && tensorOffDiag != nullptr; }
+    /// Fiber types the grid distinguishes (1 when it has no fraction grids).
+    std::size_t fiberTypeCount() const { return std::max<std::size_t>(1, typeFraction.size()); }
     /// Active voxels of the density grid (the other grids share its topology).
     std::uint64_t activeVoxelCount() const;
     /// In-memory size of all grids, bytes.
