@@ -22,8 +22,8 @@ struct RawHit {
 };
 
 /// The intersect context of every query: Embree passes it to the filter
-/// (RayScene::filterHits), which skips end caps and the ray origin's own
-/// fiber, and collects every hit when asked to.
+/// (RayScene::filterHits), which skips hits off the ribbons and the ray
+/// origin's own fiber, and collects every hit when asked to.
 struct FilterContext {
     RTCIntersectContext context;
     const RayScene* scene;
@@ -127,12 +127,17 @@ struct RayScene::Impl {
         const auto [a, b] = segmentEnds(s);
         return segmentArcStart[s] + segmentParameter(s, p) * glm::distance(a, b);
     }
-    /// Whether p, a hit on piece `piece`, lies on an end cap — beyond the
-    /// piece's ends along it. Embree's flat linear curves have round caps; the
-    /// fibers here are butt-ended ribbons, as the rasterizer draws them and as
-    /// the global term's cross-section λ·k·D·cos θ counts them (nothing end-on).
-    bool onCap(std::uint32_t piece, const Vec3f& p) const {
+    /// Whether p, a hit on piece `piece`, lies off the ribbon: on an end cap
+    /// (beyond the piece's ends along it) or on a piece of width 0. Embree's
+    /// flat linear curves have round caps; the fibers here are butt-ended
+    /// ribbons, as the rasterizer draws them and as the global term's
+    /// cross-section λ·k·D·cos θ counts them (nothing end-on). A piece of
+    /// width 0 (a tapered tip, D_i = 0) covers nothing, though Embree reports
+    /// a ray exactly through its centreline.
+    bool offRibbon(std::uint32_t piece, const Vec3f& p) const {
         const float* v = &pieceVertices[4 * std::size_t(pieceStart[piece])];
+        if (v[3] == 0.0f && v[7] == 0.0f)
+            return true;
         const Vec3f a(v[0], v[1], v[2]), b(v[4], v[5], v[6]);
         const Vec3f ab = b - a;
         const float along = glm::dot(p - a, ab);
@@ -156,11 +161,16 @@ struct RayScene::Impl {
 RayScene::RayScene(const Groom& groom, const FiberScale& scale,
                    std::shared_ptr<const SurfaceScene> surfaces)
     : impl_(std::make_unique<Impl>())
-    , width_(scale.ribbonWidth())
-    , locateDistance_(std::max(1.0f, scale.densityMultiplier) * scale.diameter)
     , surfaces_(std::move(surfaces)) {
     Impl& m = *impl_;
-    const float radius = 0.5f * width_;
+    // The widest ribbon bounds the joint test in crossings() and locate()'s
+    // search: max(D_i, k·D_i) at the widest point, k·D_i / (k·D) times the
+    // scale's max(D, k·D) (exactly that without per-point diameters).
+    width_ = 0;
+    for (std::size_t i = 0; i < groom.pointCount(); ++i)
+        width_ = std::max(width_, ribbonWidthAt(groom, scale, i));
+    locateDistance_ =
+        std::max(1.0f, scale.densityMultiplier) * scale.diameter * (width_ / scale.ribbonWidth());
     m.points = groom.points;
     m.pointTangent.resize(groom.pointCount());
     m.pieceVertices.reserve(4 * (kPiecesPerSegment * groom.pointCount() + 1));
@@ -180,17 +190,22 @@ RayScene::RayScene(const Groom& groom, const FiberScale& scale,
             arc += glm::distance(groom.points[i], groom.points[i + 1]);
             // The segment's pieces share their ends; consecutive pieces of a
             // strand are consecutive primitives (the joint test in crossings()).
+            // The radius, half the ribbon width k·D_i, is linear along the
+            // segment (strands/groom.h ribbonWidthAt()).
+            const float r0 = 0.5f * ribbonWidthAt(groom, scale, i);
+            const float r1 = 0.5f * ribbonWidthAt(groom, scale, i + 1);
             for (std::uint32_t j = 0; j < kPiecesPerSegment; ++j) {
                 m.pieceStart.push_back(static_cast<std::uint32_t>(m.pieceVertices.size() / 4));
                 m.pieceSegment.push_back(segment);
-                const Vec3f p = groom.points[i] + (float(j) / float(kPiecesPerSegment)) *
-                                                      (groom.points[i + 1] - groom.points[i]);
-                m.pieceVertices.insert(m.pieceVertices.end(), {p.x, p.y, p.z, radius});
+                const float f = float(j) / float(kPiecesPerSegment);
+                const Vec3f p = groom.points[i] + f * (groom.points[i + 1] - groom.points[i]);
+                m.pieceVertices.insert(m.pieceVertices.end(), {p.x, p.y, p.z, r0 + f * (r1 - r0)});
             }
         }
         if (end > first + 1) { // the strand's last point closes its last piece
             const Vec3f& p = groom.points[end - 1];
-            m.pieceVertices.insert(m.pieceVertices.end(), {p.x, p.y, p.z, radius});
+            m.pieceVertices.insert(m.pieceVertices.end(),
+                                   {p.x, p.y, p.z, 0.5f * ribbonWidthAt(groom, scale, end - 1)});
         }
     }
     m.strandFirstSegment.push_back(static_cast<std::uint32_t>(m.segmentStart.size()));
@@ -250,7 +265,7 @@ void RayScene::crossings(const Vec3f& origin, const Vec3f& dir, float tMax,
         return a.t != b.t ? a.t < b.t : a.primID < b.primID;
     });
     // A ray through the joint of two consecutive pieces of one strand hits
-    // both ribbons within about a ribbon width: one crossing.
+    // both ribbons within about a ribbon width (at most the widest): one crossing.
     thread_local std::vector<std::uint32_t> pieces; // the kept crossings' pieces
     pieces.clear();
     for (const RawHit& h : hits) {
@@ -279,7 +294,7 @@ void RayScene::filterHits(const RTCFilterFunctionNArguments* args) {
         const Vec3f p(RTCRayN_org_x(args->ray, args->N, i) + t * RTCRayN_dir_x(args->ray, args->N, i),
                       RTCRayN_org_y(args->ray, args->N, i) + t * RTCRayN_dir_y(args->ray, args->N, i),
                       RTCRayN_org_z(args->ray, args->N, i) + t * RTCRayN_dir_z(args->ray, args->N, i));
-        if (m.onCap(piece, p)) {
+        if (m.offRibbon(piece, p)) {
             args->valid[i] = 0;
             continue;
         }

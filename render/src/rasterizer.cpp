@@ -38,8 +38,9 @@ double secondsSince(Clock::time_point start) {
 // --- geometry shared by all tiles ------------------------------------------
 
 /// Unit tangent at every point (strandTangents(): the bisector of the
-/// adjacent segments' directions), and every point's projection.
-void prepareVertices(const Groom& groom, const Camera& camera, float radius,
+/// adjacent segments' directions), and every point's projection with its
+/// ribbon half-width k·D_i/2 (ribbonWidthAt()).
+void prepareVertices(const Groom& groom, const Camera& camera, const FiberScale& scale,
                      std::vector<Vec3f>& tangents,
                      std::vector<raster::ProjectedVertex>& projected) {
     tangents.resize(groom.pointCount());
@@ -47,14 +48,17 @@ void prepareVertices(const Groom& groom, const Camera& camera, float radius,
     tbb::parallel_for(
         tbb::blocked_range<std::size_t>(0, groom.strandCount(), 512),
         [&](const tbb::blocked_range<std::size_t>& range) {
+            std::vector<float> radii;
             for (std::size_t s = range.begin(); s != range.end(); ++s) {
                 const std::size_t begin = groom.strandStart[s], end = groom.strandStart[s + 1];
                 strandTangents({groom.points.data() + begin, end - begin},
                                {tangents.data() + begin, end - begin});
+                radii.resize(end - begin);
+                for (std::size_t i = begin; i < end; ++i)
+                    radii[i - begin] = 0.5f * ribbonWidthAt(groom, scale, i);
                 const std::span<const Vec3f> points(groom.points.data() + begin, end - begin);
-                raster::projectStrand(camera, points, {tangents.data() + begin, end - begin},
-                                      radius, camera.nearClip(),
-                                      {projected.data() + begin, end - begin});
+                raster::projectStrand(camera, points, {tangents.data() + begin, end - begin}, radii,
+                                      camera.nearClip(), {projected.data() + begin, end - begin});
             }
         });
 }
@@ -99,7 +103,6 @@ struct RenderContext {
     const ShaderLayout& layout;
     const RasterSettings& settings;
     const SurfaceLayer& surfaces;
-    float fiberRadius;
     std::size_t stride;         ///< floats per shaded point
     std::size_t radianceFloats; ///< of those, the radiance layers'
     std::vector<Vec3f> tangents;
@@ -124,7 +127,6 @@ struct RenderContext {
         , layout(sh.layout())
         , settings(st)
         , surfaces(su)
-        , fiberRadius(0.5f * st.fiberScale.ribbonWidth())
         , stride(layout.stride())
         , radianceFloats(layout.radianceFloats()) {}
 
@@ -132,8 +134,10 @@ struct RenderContext {
         const std::uint32_t k = firstPoint[segment];
         if (projected[k].valid() && projected[k + 1].valid())
             return raster::ribbonBetween(projected[k], projected[k + 1]);
-        return raster::projectRibbon(camera, groom.points[k], groom.points[k + 1], tangents[k],
-                                     tangents[k + 1], fiberRadius, camera.nearClip());
+        return raster::projectRibbon(
+            camera, groom.points[k], groom.points[k + 1], tangents[k], tangents[k + 1],
+            0.5f * ribbonWidthAt(groom, settings.fiberScale, k),
+            0.5f * ribbonWidthAt(groom, settings.fiberScale, k + 1), camera.nearClip());
     }
     std::uint32_t strandOfPoint(std::uint32_t point) const {
         const auto it = std::upper_bound(groom.strandStart.begin(), groom.strandStart.end(), point);
@@ -795,7 +799,7 @@ RasterOutput rasterize(const Groom& groom, const Camera& camera, const FragmentS
         ctx.averageLayer.push_back(film.addLayer(a.name, a.channels));
     ctx.film = &film;
 
-    prepareVertices(groom, ctx.camera, ctx.fiberRadius, ctx.tangents, ctx.projected);
+    prepareVertices(groom, ctx.camera, settings.fiberScale, ctx.tangents, ctx.projected);
     ctx.firstPoint = segmentFirstPoints(groom);
     ctx.tilesX = (ctx.camera.width() + kTileSize - 1) / kTileSize;
     ctx.tilesY = (ctx.camera.height() + kTileSize - 1) / kTileSize;

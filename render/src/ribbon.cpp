@@ -78,7 +78,7 @@ void setBounds(ScreenRibbon& r) {
 } // namespace
 
 void projectStrand(const Camera& camera, std::span<const Vec3f> points,
-                   std::span<const Vec3f> tangents, float radius, float zNear,
+                   std::span<const Vec3f> tangents, std::span<const float> radii, float zNear,
                    std::span<ProjectedVertex> out) {
     const double focal = camera.focalLength();
     const std::size_t n = points.size();
@@ -96,16 +96,17 @@ void projectStrand(const Camera& camera, std::span<const Vec3f> points,
             fallback = out[k + 1].raster - out[k].raster;
         else if (k > 0 && out[k - 1].valid())
             fallback = out[k].raster - out[k - 1].raster;
-        out[k].offset = ribbonOffset(camera.toCamera(points[k]),
-                                     camera.directionToCamera(tangents[k]), focal, radius,
-                                     fallback);
+        out[k].offset =
+            ribbonOffset(camera.toCamera(points[k]), camera.directionToCamera(tangents[k]), focal,
+                         radii[k], fallback);
     }
     // Miter joins: at an inner vertex the offset runs along the bent strand's
     // bisector, so its projection onto each adjacent segment's normal — the
     // ribbon's width there — is shorter by the cosine of half the bend.
     // Lengthen it by that cosine's inverse (capped, like SVG's miter limit, at
-    // 4: a bend sharper than 150° keeps a shorter spike) so the ribbon is D wide
-    // along every segment and its area is D times its length.
+    // 4: a bend sharper than 150° keeps a shorter spike) so the ribbon is 2·r_k
+    // wide along both segments at vertex k and its area is its width's
+    // integral along its length.
     constexpr double kMiterLimit = 4.0;
     for (std::size_t k = 1; k + 1 < n; ++k) {
         if (!out[k - 1].valid() || !out[k].valid() || !out[k + 1].valid())
@@ -138,7 +139,7 @@ ScreenRibbon ribbonBetween(const ProjectedVertex& a, const ProjectedVertex& b) {
 }
 
 std::optional<ScreenRibbon> projectRibbon(const Camera& camera, const Vec3f& p0, const Vec3f& p1,
-                                          const Vec3f& u0, const Vec3f& u1, float radius,
+                                          const Vec3f& u0, const Vec3f& u1, float r0, float r1,
                                           float zNear) {
     Vec3f c0 = camera.toCamera(p0), c1 = camera.toCamera(p1);
     if (c0.z < zNear && c1.z < zNear)
@@ -151,13 +152,16 @@ std::optional<ScreenRibbon> projectRibbon(const Camera& camera, const Vec3f& p0,
         const float t = (zNear - c0.z) / (c1.z - c0.z);
         const Vec3f c = c0 + t * (c1 - c0);
         const Vec3f v = lerp(t, v0, v1); // only its projected direction matters
+        const float rc = r0 + t * (r1 - r0);
         if (c0.z < zNear) {
             c0 = c;
             v0 = v;
+            r0 = rc;
             r.t0 = t;
         } else {
             c1 = c;
             v1 = v;
+            r1 = rc;
             r.t1 = t;
         }
         c0.z = std::max(c0.z, zNear);
@@ -168,8 +172,8 @@ std::optional<ScreenRibbon> projectRibbon(const Camera& camera, const Vec3f& p0,
     r.s1 = Vec2d(camera.toRaster(c1));
     r.invZ0 = 1.0f / c0.z;
     r.invZ1 = 1.0f / c1.z;
-    r.o0 = ribbonOffset(c0, v0, focal, radius, r.s1 - r.s0);
-    r.o1 = ribbonOffset(c1, v1, focal, radius, r.s1 - r.s0);
+    r.o0 = ribbonOffset(c0, v0, focal, r0, r.s1 - r.s0);
+    r.o1 = ribbonOffset(c1, v1, focal, r1, r.s1 - r.s0);
     setBounds(r);
     return r;
 }

@@ -4,9 +4,10 @@
 // The ribbon of segment p0 → p1 (vertex tangents u0, u1) is the quad
 //   A = s0 + o0,  B = s1 + o1,  C = s1 − o1,  D = s0 − o0
 // where s_k is the raster position of p_k and o_k is the image of the
-// half-width of the ray-facing ribbon at p_k (D/2 across the tangent and the
-// line of sight: the ribbon Embree's flat curves intersect), lengthened at a
-// bend to a miter join so that the ribbon is D wide along both segments.
+// half-width of the ray-facing ribbon at p_k (r_k = k·D_k/2 across the tangent
+// and the line of sight: the ribbon Embree's flat curves intersect), lengthened
+// at a bend to a miter join so that the ribbon is 2·r_k wide along both
+// segments there. The width is linear along the segment, as Embree's is.
 // Since o_k depends only on vertex k, consecutive segments of a strand share
 // an edge.
 // A segment crossing the near plane is clipped in 3D first; t0/t1 remember
@@ -66,21 +67,21 @@ struct ProjectedVertex {
     bool valid() const { return invZ > 0; }
 };
 
-/// Projects the points of one strand (unit tangents, world half-width
-/// `radius`). A tangent pointing at the camera takes its offset from the
-/// direction toward a projected neighbour.
+/// Projects the points of one strand (unit tangents, world half-widths
+/// `radii`, one per point). A tangent pointing at the camera takes its offset
+/// from the direction toward a projected neighbour.
 void projectStrand(const Camera& camera, std::span<const Vec3f> points,
-                   std::span<const Vec3f> tangents, float radius, float zNear,
+                   std::span<const Vec3f> tangents, std::span<const float> radii, float zNear,
                    std::span<ProjectedVertex> out);
 
 /// The ribbon between two valid projected vertices.
 ScreenRibbon ribbonBetween(const ProjectedVertex& a, const ProjectedVertex& b);
 
-/// The ribbon of a segment p0 → p1 that crosses the near plane `zNear`
-/// (camera space), clipped in 3D; nullopt if it lies wholly nearer. Raster
-/// bounds are not clipped to the image.
+/// The ribbon of a segment p0 → p1 (world half-widths r0, r1 at its ends)
+/// that crosses the near plane `zNear` (camera space), clipped in 3D; nullopt
+/// if it lies wholly nearer. Raster bounds are not clipped to the image.
 std::optional<ScreenRibbon> projectRibbon(const Camera& camera, const Vec3f& p0, const Vec3f& p1,
-                                          const Vec3f& u0, const Vec3f& u1, float radius,
+                                          const Vec3f& u0, const Vec3f& u1, float r0, float r1,
                                           float zNear);
 
 /// Calls emit(x, y, coverage) for every pixel of [x0, x1) × [y0, y1) that the

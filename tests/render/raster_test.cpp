@@ -43,13 +43,15 @@ double focalPixels(int height, double fovDegrees) {
     return 0.5 * height / std::tan(0.5 * fovDegrees * Pi / 180.0);
 }
 
-/// The image area, in pixels, of the ray-facing ribbon of width D along a → b
-/// seen by a pinhole at `eye` looking down −z with focal length f pixels,
-/// built independently of the rasterizer: the exact images of the ribbon's
-/// edges p ± (D/2)·(ω × u)/|ω × u|, ω the line of sight, over 4096
-/// sub-segments (shoelace). On the optical axis it is D·f × L·f; off it the
+/// The image area, in pixels, of the ray-facing ribbon along a → b whose
+/// width runs linearly from Da at a to Db at b, seen by a pinhole at `eye`
+/// looking down −z with focal length f pixels, built independently of the
+/// rasterizer: the exact images of the ribbon's edges
+/// p ± (D/2)·(ω × u)/|ω × u|, ω the line of sight, over 4096 sub-segments
+/// (shoelace). On the optical axis it is D·f × L·f for a width D; off it the
 /// pinhole stretches the width radially by 1/cos of the angle to the axis.
-double rayFacingRibbonArea(const Vec3d& eye, double f, const Vec3f& a, const Vec3f& b, double D) {
+double rayFacingRibbonArea(const Vec3d& eye, double f, const Vec3f& a, const Vec3f& b, double Da,
+                           double Db) {
     const Vec3d u = glm::normalize(Vec3d(b - a));
     const auto image = [&](const Vec3d& q) {
         const Vec3d d = q - eye;
@@ -57,7 +59,7 @@ double rayFacingRibbonArea(const Vec3d& eye, double f, const Vec3f& a, const Vec
     };
     const auto edges = [&](double t) {
         const Vec3d p = glm::mix(Vec3d(a), Vec3d(b), t);
-        const Vec3d w = 0.5 * D * glm::normalize(glm::cross(p - eye, u));
+        const Vec3d w = 0.5 * glm::mix(Da, Db, t) * glm::normalize(glm::cross(p - eye, u));
         return std::pair{image(p + w), image(p - w)};
     };
     double area = 0;
@@ -86,7 +88,8 @@ TEST(RasterCoverage, ThinFiberCoversWidthTimesLength) {
         const test::ConstantShader shader;
         const RasterOutput out = rasterize(groom, camera, shader, settings);
         const double expected =
-            rayFacingRibbonArea(Vec3d(0, 0, 1), f, a, b, double(settings.fiberScale.diameter));
+            rayFacingRibbonArea(Vec3d(0, 0, 1), f, a, b, double(settings.fiberScale.diameter),
+                                double(settings.fiberScale.diameter));
         // Within 1e-4 of the axis-on rectangle here.
         EXPECT_NEAR(expected,
                     double(settings.fiberScale.diameter) * f * double(glm::distance(a, b)) * f,
@@ -100,6 +103,84 @@ TEST(RasterCoverage, ThinFiberCoversWidthTimesLength) {
     }
 }
 
+TEST(RasterCoverage, PerPointDiameterSetsTheWidth) {
+    // The groom's per-point diameters D_i replace D (ribbonWidthAt()), linear
+    // along each segment: a strand twice as thick covers twice the area, one
+    // tapering from D to 0 the area of that trapezoid.
+    const int size = 256;
+    const Camera camera = testCamera(size, size, Vec3f(0, 0, 1), Vec3f(0, 0, 0));
+    const RasterSettings settings = testSettings(5e-4f); // 0.24 pixel
+    const float D = settings.fiberScale.diameter;
+    const double f = focalPixels(size, 30.0);
+    const Vec3f a(-0.1013f, -0.0571f, 0.0f), b(0.0877f, 0.0719f, 0.0f);
+    constexpr int kSegments = 7;
+    Groom plain;
+    addStraightStrand(plain, a, b, kSegments);
+    const test::ConstantShader shader;
+    const auto render = [&](std::vector<float> thickness, const RasterSettings& s) {
+        Groom groom = plain;
+        groom.thickness = std::move(thickness);
+        return rasterize(groom, camera, shader, s).film;
+    };
+    const Film one = render({}, settings);
+    // D_i = D everywhere: the same bytes as no per-point diameters.
+    EXPECT_TRUE(alpha(render(std::vector<float>(kSegments + 1, D), settings)) == alpha(one));
+    // k·D_i: D_i = D with k = 3 is the film of diameter 3·D.
+    RasterSettings k3 = settings, thick3 = settings;
+    k3.fiberScale.densityMultiplier = 3.0f;
+    thick3.fiberScale.diameter *= 3.0f;
+    EXPECT_TRUE(alpha(render(std::vector<float>(kSegments + 1, D), k3)) ==
+                alpha(render({}, thick3)));
+
+    const double sumOne = sum(alpha(one));
+    const double twice = sum(alpha(render(std::vector<float>(kSegments + 1, 2 * D), settings)));
+    const double expectedTwice =
+        rayFacingRibbonArea(Vec3d(0, 0, 1), f, a, b, 2.0 * double(D), 2.0 * double(D));
+    EXPECT_NEAR(twice, expectedTwice, 1e-6 * expectedTwice);
+    EXPECT_NEAR(twice / sumOne, 2.0, 1e-4);
+
+    std::vector<float> taper;
+    for (int k = 0; k <= kSegments; ++k)
+        taper.push_back(D * float(kSegments - k) / float(kSegments));
+    const Film tapered = render(taper, settings);
+    const double expectedTaper = rayFacingRibbonArea(Vec3d(0, 0, 1), f, a, b, double(D), 0.0);
+    EXPECT_NEAR(sum(alpha(tapered)), expectedTaper, 1e-6 * expectedTaper);
+    EXPECT_NEAR(sum(alpha(tapered)) / sumOne, 0.5, 1e-3);
+    // Near the tip the ribbon is thin: the pixel on the centreline a tenth of
+    // the length from the tip (a pixel spans ~2% of it) is covered about a
+    // tenth as much as on the plain strand.
+    const Vec2f nearTip = camera.toRaster(camera.toCamera(a + 0.9f * (b - a)));
+    const std::size_t p = one.index(int(nearTip.x), int(nearTip.y));
+    ASSERT_GT(alpha(one)[p], 0.05f);
+    EXPECT_NEAR(alpha(tapered)[p] / alpha(one)[p], 0.1f, 0.03f);
+}
+
+TEST(RasterCoverage, NearPlaneClipInterpolatesTheWidth) {
+    // A tapered segment through the near plane is clipped in 3D, its width at
+    // the clip point interpolated: the film of the same strand starting just
+    // in front of the near plane, with the width there.
+    const int size = 64;
+    const Camera camera = testCamera(size, size, Vec3f(0, 0, 1), Vec3f(0, 0, 0));
+    const RasterSettings settings = testSettings(1e-5f);
+    const Vec3f p0(0.001f, 0.0005f, 1.5f), p1(0.05f, 0.02f, -0.5f);
+    const float d0 = 4e-5f, d1 = 1e-5f;
+    // Depth 1 − z = 1.0005 × the near plane's (camera at z = 1 looking down −z).
+    const float t = (1.5f - (1.0f - 1.0005f * camera.nearClip())) / 2.0f;
+    const test::ConstantShader shader;
+    Groom clipped, inFront;
+    const Vec3f whole[2] = {p0, p1}, part[2] = {p0 + t * (p1 - p0), p1};
+    clipped.addStrand(whole);
+    clipped.thickness = {d0, d1};
+    inFront.addStrand(part);
+    inFront.thickness = {d0 + t * (d1 - d0), d1};
+    const RasterOutput c = rasterize(clipped, camera, shader, settings);
+    const RasterOutput n = rasterize(inFront, camera, shader, settings);
+    EXPECT_EQ(c.stats.segmentsOutsideView, 0u);
+    const double expected = sum(alpha(n.film));
+    EXPECT_GT(expected, 1.0);
+    EXPECT_NEAR(sum(alpha(c.film)), expected, 2e-3 * expected);
+}
+
 TEST(RasterCoverage, WideRibbonGivesTheExactQuadArea) {
     const int size = 128;
     const Camera camera = testCamera(size, size, Vec3f(0, 0, 1), Vec3f(0, 0, 0));
@@ -111,7 +192,8 @@ TEST(RasterCoverage, WideRibbonGivesTheExactQuadArea) {
     const test::ConstantShader shader;
     const RasterOutput out = rasterize(groom, camera, shader, settings);
     const double expected =
-        rayFacingRibbonArea(Vec3d(0, 0, 1), f, a, b, double(settings.fiberScale.diameter));
+        rayFacingRibbonArea(Vec3d(0, 0, 1), f, a, b, double(settings.fiberScale.diameter),
+                            double(settings.fiberScale.diameter));
     EXPECT_NEAR(sum(alpha(out.film)), expected, 1e-6 * expected);
     // The pixel at the ribbon's middle is wholly covered.
     const Vec2f mid = camera.toRaster(camera.toCamera(0.5f * (a + b)));

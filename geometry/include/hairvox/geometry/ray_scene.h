@@ -2,12 +2,14 @@
 // ray-facing ribbons and the opaque surfaces, the one geometry that exact
 // mode's shadow rays and the path tracer both intersect.
 //
-// Each strand segment is an Embree flat linear curve of width k·D (the fiber
-// scale's ribbonWidth(): a modeled strand stands for k hairs of diameter D
-// side by side, strands/fiber_scale.h), so a ray of direction ω that passes a
-// fiber of tangent u hits it with probability proportional to k·D·|ω × u| —
-// the cross-section the grid modes integrate (docs/DESIGN.md §5) — and each
-// hit is one hair.
+// Each strand segment is an Embree flat linear curve of width k·D_i at its
+// points, linear between them (strands/groom.h ribbonWidthAt(): a modeled
+// strand stands for k hairs of diameter D_i side by side, D_i the groom's
+// per-point diameter or else the fiber scale's D, strands/fiber_scale.h), so a
+// ray of direction ω that passes a fiber of tangent u hits it with
+// probability proportional to k·D_i·|ω × u| — the cross-section the grid
+// modes integrate (docs/DESIGN.md §5) — and each hit is one hair. A point of
+// width 0 (a tapered tip) is never hit.
 //
 // A hit's tangent is the shading tangent the rasterizer uses too: the strand's
 // point tangents interpolated along the segment (strands/groom.h). Embree's
@@ -34,7 +36,7 @@
 //
 // Ribbons are butt-ended: Embree's flat linear curves have round end caps,
 // whose hits are rejected, so that a ray meets exactly the cross-section
-// k·D·|ω × u| per unit length — what the rasterizer covers and what the grid
+// k·D_i·|ω × u| per unit length — what the rasterizer covers and what the grid
 // integrates (a fiber seen end-on blocks nothing).
 //
 // Surfaces: the scene's opaque spheres and meshes (geometry/surface_scene.h),
@@ -96,9 +98,10 @@ struct RayHit {
 
 class RayScene {
 public:
-    /// The groom's strands as ribbons of width scale.ribbonWidth() (locate()
-    /// searches within max(D, k·D) of a centreline) and the opaque surfaces
-    /// (null: none), which the RayScene shares.
+    /// The groom's strands as ribbons of width ribbonWidthAt(groom, scale, i)
+    /// (locate() searches within max(D_i, k·D_i) of a centreline, at the
+    /// widest point) and the opaque surfaces (null: none), which the RayScene
+    /// shares.
     RayScene(const Groom& groom, const FiberScale& scale,
              std::shared_ptr<const SurfaceScene> surfaces = nullptr);
     ~RayScene();
@@ -132,14 +135,16 @@ public:
         return strand == own.strand && std::abs(arcLength - own.arcLength) <= 1.5f * chord + slack;
     }
 
+    /// The widest ribbon's width: max over the groom's points of k·D_i (k·D
+    /// without per-point diameters; 0 for an empty groom).
     float ribbonWidth() const { return width_; }
     /// Null when the scene has no surfaces.
     const SurfaceScene* surfaces() const { return surfaces_.get(); }
 
 private:
     struct Impl;
-    /// Embree's filter for every query: rejects end-cap hits and the origin's
-    /// own fiber, or collects every hit for crossings().
+    /// Embree's filter for every query: rejects hits off the ribbons and the
+    /// origin's own fiber, or collects every hit for crossings().
     static void filterHits(const RTCFilterFunctionNArguments* args);
 
     std::unique_ptr<Impl> impl_;

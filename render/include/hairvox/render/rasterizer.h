@@ -2,9 +2,11 @@
 // front-to-back compositing, deferred shading through a FragmentShader.
 //
 // Strands are drawn as camera-facing ribbons of the fiber diameter D (world
-// units, usually far below a pixel). Each segment becomes a quad whose edges
-// at a vertex are offset by ±D/2 perpendicular to that vertex's projected
-// tangent, so consecutive segments share an edge (no gaps, no overlaps).
+// units, usually far below a pixel), or of the groom's per-point diameter D_i
+// (strands/groom.h ribbonWidthAt(): linear along a segment). Each segment
+// becomes a quad whose edges at a vertex are offset by ±D_i/2 perpendicular
+// to that vertex's projected tangent, so consecutive segments share an edge
+// (no gaps, no overlaps).
 // Coverage is analytic: the exact area of quad ∩ pixel square (box filter),
 // so thin hair neither aliases nor sparkles (ribbon.h).
 //
@@ -70,7 +72,7 @@ struct SurfaceLayer {
 };
 
 struct RasterSettings {
-    FiberScale fiberScale; ///< ribbons D wide; a strand's coverage counts k hairs
+    FiberScale fiberScale; ///< ribbons k·D (k·D_i) wide: a strand's coverage counts k hairs
     ShadingRate shadingRate = ShadingRate::Fragment;
     Rgb background{0.0f}; ///< radiance behind everything
     /// A pixel is opaque once its transmittance is ≤ this: fragments behind it
