@@ -166,9 +166,7 @@ RayScene::RayScene(const Groom& groom, const FiberScale& scale,
     // The widest ribbon bounds the joint test in crossings() and locate()'s
     // search: max(D_i, k·D_i) at the widest point, k·D_i / (k·D) times the
     // scale's max(D, k·D) (exactly that without per-point diameters).
-    width_ = 0;
-    for (std::size_t i = 0; i < groom.pointCount(); ++i)
-        width_ = std::max(width_, ribbonWidthAt(groom, scale, i));
+    width_ = maxRibbonWidth(groom, scale);
     locateDistance_ =
         std::max(1.0f, scale.densityMultiplier) * scale.diameter * (width_ / scale.ribbonWidth());
     m.points = groom.points;

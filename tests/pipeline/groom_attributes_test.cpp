@@ -280,5 +280,59 @@ TEST(GroomAttributes, WhatIsUsedIsReportedAndTransparencyIsWarnedAbout) {
     }
 }
 
+/// Σ hair coverage and the coverage-weighted mean key.V over the image.
+std::pair<double, double> coverageAndVisibility(const Film& film) {
+    double a = 0, v = 0;
+    const auto V = film.find("key.V");
+    for (std::size_t i = 0; i < std::size_t(film.width()) * std::size_t(film.height()); ++i) {
+        const double alpha = double(film.layer(kHairAlphaLayer).scalar(i));
+        a += alpha;
+        v += V ? alpha * double(film.layer(*V).scalar(i)) : 0.0;
+    }
+    return {a, a > 0 ? v / a : 0.0};
+}
+
+TEST(GroomThickness, PerPointDiametersReachEveryStageAsAWiderFiberWould) {
+    // Strands of thickness 2D in the file render as strands of diameter 2D:
+    // the same coverage in the rasterizer and the path tracer, the same
+    // shadowing in every global-term mode (the splat's weight D_i/D, the
+    // exact ribbons' width); and more coverage and shadow than D-wide strands.
+    test::TempDir dir;
+    PipelineOptions options;
+    options.tableCacheDir = dir / "cache";
+    const Rgb grey(0.4f);
+    for (const Integrator integrator : {Integrator::DualScattering, Integrator::Path})
+        for (const GlobalTermMode mode : {GlobalTermMode::Grid, GlobalTermMode::Exact}) {
+            if (integrator == Integrator::Path && mode != GlobalTermMode::Grid)
+                continue;
+            const std::string what = strCat(toString(integrator), " ", toString(mode));
+            Scene thin = twoToneScene(dir, grey, grey);
+            thin.integrator = integrator;
+            thin.globalTermMode = mode;
+            thin.exact.rays = 64;
+            thin.fiberScale.densityMultiplier = 4;
+            const auto [thinA, thinV] = coverageAndVisibility(renderScene(thin, options, false).film);
+
+            Scene wide = thin;
+            wide.fiberScale.diameter *= 2;
+            const auto [wideA, wideV] = coverageAndVisibility(renderScene(wide, options, false).film);
+
+            Scene thick = thin;
+            thick.groom.file = dir / "thick.hair";
+            LoadedGroom loaded = readGroom(thin.groom.file);
+            loaded.groom.thickness.assign(loaded.groom.pointCount(), 2 * thin.fiberScale.diameter);
+            writeHairFile(thick.groom.file, loaded.groom);
+            const SceneRender r = renderScene(thick, options, false);
+            const auto [thickA, thickV] = coverageAndVisibility(r.film);
+
+            EXPECT_NEAR(thickA, wideA, 1e-3 * wideA) << what;
+            EXPECT_GT(thickA, 1.05 * thinA) << what; // overlapping strands: less than 2×
+            if (integrator == Integrator::DualScattering) {
+                EXPECT_NEAR(thickV, wideV, 0.01) << what;
+                EXPECT_LT(thickV, thinV - 0.05) << what << ": wider fibers cast more shadow";
+            }
+        }
+}
+
 } // namespace
 } // namespace hairvox

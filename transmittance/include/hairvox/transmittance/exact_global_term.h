@@ -18,7 +18,8 @@
 // The own strand is the query's strand hint or else the strand whose
 // centreline passes within max(D, k·D) of the point (RayScene::locate()); its
 // crossings are dropped by RayScene::isOwnFiber() with a slack of
-// 2(r + k·D), while a curl looping back across the ray counts.
+// 2(r + k·D), while a curl looping back across the ray counts. With per-point
+// diameters D is the groom's widest (RayScene::ribbonWidth()).
 #pragma once
 
 #include <hairvox/strands/groom.h>
