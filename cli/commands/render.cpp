@@ -1,5 +1,6 @@
 // hairvox render [SCENE.json] [--exr OUT.exr] [--png OUT.png] [-o OUT.exr|OUT.png]
-//                [--integrator dual_scattering|path] [--mode exact|grid|approx] [--spp N]
+//                [--integrator dual_scattering|path] [--mode exact|grid|approx]
+//                [--shading-rate fragment|vertex] [--spp N]
 //                [--time-limit S] [--seed S] [--continue] [--width W] [--height H]
 //                [--voxel-size V] [--max-memory GIB] [--threads N] [--quiet]
 // Renders a scene (or the embedded default scene) to EXR + PNG and prints the
@@ -28,7 +29,7 @@ namespace {
 struct RenderCommandOptions {
     std::string scene;
     std::string output, exr, png;
-    std::string mode, integrator;
+    std::string mode, integrator, shadingRate;
     std::optional<std::uint32_t> spp;
     std::optional<double> timeLimit;
     std::optional<std::uint64_t> seed;
@@ -134,6 +135,8 @@ void runRender(const RenderCommandOptions& opt) {
         scene.globalTermMode = *kGlobalTermModeNames.parse(opt.mode); // CLI11 checked the choice
     if (!opt.integrator.empty())
         scene.integrator = *kIntegratorNames.parse(opt.integrator);
+    if (!opt.shadingRate.empty())
+        scene.shadingRate = *kShadingRateNames.parse(opt.shadingRate);
     if ((opt.spp || opt.timeLimit || opt.seed || opt.continueRun) &&
         scene.integrator != Integrator::Path)
         throw InputError("--spp, --time-limit, --seed and --continue apply to the path integrator "
@@ -191,6 +194,10 @@ void addRenderCommand(CLI::App& app) {
         ->check(CLI::IsMember(kIntegratorNames.names()));
     cmd->add_option("--mode", opt->mode, "Global-term mode (dual scattering)")
         ->check(CLI::IsMember(kGlobalTermModeNames.names()));
+    cmd->add_option("--shading-rate", opt->shadingRate,
+                    "Where the dual-scattering shader is evaluated: fragment or vertex "
+                    "(docs/scene.md)")
+        ->check(CLI::IsMember(kShadingRateNames.names()));
     cmd->add_option("--spp", opt->spp, "Path tracing: samples per pixel [1, 1000000]");
     cmd->add_option("--time-limit", opt->timeLimit,
                     "Path tracing: stop after this many seconds (whole passes) [0, 1e7]");

@@ -11,6 +11,7 @@
 #include <hairvox/strands/groom_io.h>
 #include <hairvox/transmittance/exact_global_term.h>
 
+#include <tbb/parallel_for.h>
 #include <tbb/task_group.h>
 
 #include <algorithm>
@@ -328,27 +329,31 @@ SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& opti
         result.voxelSize = assets->grid->info.voxelSize;
     }
 
-    // Per light: skip what cannot light anything, prepare the rest (the cache).
-    std::vector<std::unique_ptr<LightGlobalTerm>> terms;
-    for (const Light& light : scene.lights) {
-        LightReport report;
+    // Per light: skip what cannot light anything, prepare the rest (the
+    // cache). The lights are prepared concurrently: each preparation is
+    // parallel, but has serial steps (the brick layout, the cache's frame)
+    // that another light's work fills.
+    const std::size_t lightCount = scene.lights.size();
+    std::vector<std::unique_ptr<LightGlobalTerm>> terms(lightCount);
+    result.lights.resize(lightCount);
+    const auto prepareStart = Clock::now();
+    tbb::parallel_for(std::size_t(0), lightCount, [&](std::size_t l) {
+        const Light& light = scene.lights[l];
+        LightReport& report = result.lights[l];
         report.name = light.name;
         const auto start = Clock::now();
-        std::unique_ptr<LightGlobalTerm> term;
         if (light.isDark()) {
             report.skipped = true;
         } else {
-            term = assets->globalTerm->forLight(light);
-            if (term->blocksEverything()) {
+            terms[l] = assets->globalTerm->forLight(light);
+            if (terms[l]->blocksEverything()) {
                 report.skipped = true;
-                term.reset();
+                terms[l].reset();
             }
         }
         report.prepareSeconds = secondsSince(start);
-        result.times.globalTerm += report.prepareSeconds;
-        result.lights.push_back(report);
-        terms.push_back(std::move(term));
-    }
+    });
+    result.times.globalTerm += secondsSince(prepareStart);
 
     // The surfaces as the camera sees them, lit through the hair.
     const Camera camera(scene.camera);
@@ -691,8 +696,9 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
             " segment-tiles behind surfaces, " + thousands(st.segmentTilesSkipped) +
             " segment-tiles opaque");
     row("shade", r.times.shade,
-        thousands(st.shadingPoints) + " shading points; skipped " +
-            thousands(st.fragmentsBehindOpaque) + " fragments behind opaque pixels");
+        strCat(thousands(st.shadingPoints), " shading points (", toString(scene.shadingRate),
+               " rate); skipped ", thousands(st.fragmentsBehindOpaque),
+               " fragments behind opaque pixels"));
     row("write", r.times.write, written.empty() ? "nothing" : written);
 }
 

@@ -179,6 +179,19 @@ TEST(CliRenderWarnings, WidthAloneKeepsTheCameraAspect) {
     EXPECT_TRUE(contains(r.output, "40x20")) << r.output;
 }
 
+TEST(CliRenderOptions, ShadingRateIsChosenOnTheCommandLine) {
+    test::TempDir dir;
+    SmallScene scene;
+    scene.output = outputs(dir / "r.exr", dir / "r.png");
+    const fs::path file = scene.write(dir);
+    auto r = test::runHairvox("render " + quoted(file) + " --shading-rate vertex");
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_TRUE(contains(r.output, "(vertex rate)")) << r.output;
+    r = test::runHairvox("render " + quoted(file) + " --shading-rate pixel");
+    EXPECT_NE(r.exitCode, 0);
+    EXPECT_TRUE(contains(r.output, "--shading-rate")) << r.output;
+}
+
 TEST(CliRenderMemory, AbsurdSizeFailsFastWithTheEstimate) {
     test::TempDir dir;
     const auto start = std::chrono::steady_clock::now();

@@ -4,8 +4,13 @@
 
 #include <glm/common.hpp>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
+#include <memory>
+#include <new>
 #include <limits>
 #include <span>
 
@@ -51,7 +56,7 @@ BrickVolume::BrickVolume(double voxelSize)
     , slots_(64, -1) {}
 
 std::size_t BrickVolume::memoryBytes() const {
-    return values_.capacity() * sizeof(Lanes) + brickCoord_.capacity() * sizeof(glm::ivec3) +
+    return valueCount_ * sizeof(Lanes) + brickCoord_.capacity() * sizeof(glm::ivec3) +
            slots_.capacity() * sizeof(std::int64_t);
 }
 
@@ -88,7 +93,6 @@ std::int64_t BrickVolume::insert(const glm::ivec3& b) {
         i = (i + 1) & mask;
     slots_[i] = static_cast<std::int64_t>(brickCount_);
     brickCoord_.push_back(b);
-    values_.resize(values_.size() + kBrickValues);
     if (brickCount_ == 0) {
         brickMin_ = brickMax_ = b;
     } else {
@@ -102,6 +106,22 @@ void BrickVolume::reserveBrick(const glm::ivec3& b, int lowFaces) {
     for (int mask = 0; mask < 8; ++mask)
         if ((mask & lowFaces) == mask)
             insert(b - glm::ivec3((mask >> 2) & 1, (mask >> 1) & 1, mask & 1));
+}
+
+void BrickVolume::AlignedDelete::operator()(Lanes* p) const {
+    ::operator delete[](p, std::align_val_t(alignof(Lanes)));
+}
+
+void BrickVolume::allocate() {
+    valueCount_ = brickCount_ * std::size_t(kBrickValues);
+    // Lanes is an aggregate (an implicit-lifetime type): raw storage filled
+    // with value-initialised Lanes, brick by brick on the threads.
+    values_.reset(static_cast<Lanes*>(
+        ::operator new[](valueCount_ * sizeof(Lanes), std::align_val_t(alignof(Lanes)))));
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, brickCount_, 16), [&](const auto& r) {
+        std::uninitialized_value_construct(values_.get() + r.begin() * kBrickValues,
+                                           values_.get() + r.end() * kBrickValues);
+    });
 }
 
 BrickVolume::BrickSet BrickVolume::brickSet(const glm::ivec3& b) const {

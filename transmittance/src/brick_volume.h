@@ -17,6 +17,7 @@
 #include <glm/vec3.hpp>
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -74,10 +75,14 @@ public:
         std::int64_t brick[8];
     };
 
-    /// Creates (zeroed) brick b and, for each bit of `lowFaces` (4 x, 2 y, 1 z:
-    /// b has values on that low face), the bricks whose aprons hold them.
-    /// Not thread-safe; call for every brick before any set().
+    /// Registers brick b and, for each bit of `lowFaces` (4 x, 2 y, 1 z: b
+    /// has values on that low face), the bricks whose aprons hold them. Not
+    /// thread-safe; call for every brick, then allocate(), before any set().
     void reserveBrick(const glm::ivec3& b, int lowFaces);
+    /// Allocates the values of every reserved brick at once, zeroed in
+    /// parallel (the pages are first touched by the threads that will fill
+    /// them, not faulted in serially by a growing vector).
+    void allocate();
     BrickSet brickSet(const glm::ivec3& b) const;
     /// Stores the value of the voxel at `local` ∈ [0, 8)³ of the brick set's
     /// brick, in its brick and the aprons below. Thread-safe for distinct voxels.
@@ -127,7 +132,12 @@ private:
     std::vector<std::int64_t> slots_;  ///< open addressing: brick index per slot, −1 if free
     std::size_t brickCount_ = 0;
     std::vector<glm::ivec3> brickCoord_; ///< per brick
-    std::vector<Lanes> values_;          ///< brickCount_ × kBrickValues
+    struct AlignedDelete {
+        void operator()(Lanes* p) const;
+    };
+    /// brickCount_ × kBrickValues, once allocate() has run.
+    std::unique_ptr<Lanes[], AlignedDelete> values_;
+    std::size_t valueCount_ = 0;
     glm::ivec3 brickMin_{0}, brickMax_{-1};
 };
 

@@ -140,6 +140,7 @@ BrickVolume GridModel::buildRates(const Light& light) const {
         }
         volume.reserveBrick(brickOf(*leaf), lowFaces);
     }
+    volume.allocate();
     const float kD = settings_.fiberScale.ribbonWidth();
     const bool tensor = options_.orientation == OrientationModel::Tensor;
     const bool poisson = options_.estimator == AttenuationEstimator::Poisson;
