@@ -221,7 +221,11 @@ SceneGroom loadGroom(const Scene& scene) {
     SceneGroom g;
     if (scene.groom.isProcedural()) {
         g.groom = generateGroom(scene.groom.procedural);
-        g.palette.fibers.push_back(scene.fiber);
+        g.palette = resolveColors(g.groom, scene.groom.color, scene.fiber, "procedural groom",
+                                  g.warnings);
+        if (!g.palette.colors.empty())
+            g.notes.push_back(strCat(g.palette.size(), " fiber type(s) from the procedural "
+                                                       "groom's colours: sigma_a replaces the scene's"));
         return g;
     }
     const std::string source = scene.groom.file.string();

@@ -105,6 +105,11 @@ ProceduralGroomParams parseProcedural(JsonObject obj) {
     set("curl_radius", [&](const JsonValue& v) { p.curlRadius = v.numberF(kAny); });
     set("curl_pitch", [&](const JsonValue& v) { p.curlPitch = v.numberF(kAny); });
     set("clump_strength", [&](const JsonValue& v) { p.clumpStrength = v.numberF(kAny); });
+    set("colors", [&](const JsonValue& v) {
+        p.colors.clear();
+        for (const JsonValue& c : v.array(1, kMaxFiberTypes))
+            p.colors.push_back(c.rgb(kAlbedo));
+    });
     set("head_center", [&](const JsonValue& v) { p.headCenter = v.vec3(kCoordinate); });
     set("head_radius", [&](const JsonValue& v) { p.headRadius = v.numberF(kAny); });
     obj.finish();

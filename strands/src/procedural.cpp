@@ -39,6 +39,10 @@ void ProceduralGroomParams::validate() const {
     requireRange("curl radius", curlRadius, 0.0f, 1e2f);
     requireRange("curl pitch", curlPitch, 1e-5f, 1e3f);
     requireRange("clump strength", clumpStrength, 0.0f, 1.0f);
+    requireRange("colours", colors.size(), std::size_t(0), kMaxFiberTypes);
+    for (const Rgb& c : colors)
+        for (int k = 0; k < 3; ++k)
+            requireRange("colour channel", c[k], 0.0f, 1.0f);
 }
 
 std::ostream& operator<<(std::ostream& os, const ProceduralGroomParams& p) {
@@ -224,6 +228,14 @@ Groom generateGroom(const ProceduralGroomParams& params) {
                     static_cast<float>(TwoPi) * rng.uniformFloat(),
                     0.85f + 0.3f * rng.uniformFloat()};
     }
+    // Each clump's colour, from a stream of its own (the geometry's are untouched).
+    std::vector<Rgb> clumpColor;
+    for (std::uint32_t c = 0; c < clumpCount && !params.colors.empty(); ++c) {
+        Pcg32 rng(params.seed, 0xc0105ull + 2ull * c);
+        clumpColor.push_back(params.colors[std::min<std::size_t>(
+            static_cast<std::size_t>(rng.uniformFloat() * float(params.colors.size())),
+            params.colors.size() - 1)]);
+    }
 
     Groom groom;
     groom.points.reserve(std::uint64_t(params.strands) * points);
@@ -256,6 +268,8 @@ Groom generateGroom(const ProceduralGroomParams& params) {
         for (Vec3f& p : line)
             p = head.pushOut(p, head.radius * 1.003f);
         groom.addStrand(line);
+        if (!clumpColor.empty())
+            groom.color.insert(groom.color.end(), line.size(), clumpColor[clump]);
     }
     return groom;
 }

@@ -369,6 +369,14 @@ TEST(Scene, GroomAttributeRulesAndFiberColourAreRead) {
     EXPECT_EQ(d.groom.thickness, GroomThickness::Auto);
     EXPECT_EQ(d.groom.color, GroomColor::Use);
 
+    nlohmann::json c = validScene();
+    c["groom"]["procedural"]["colors"] = {{0.8, 0.6, 0.4}, {0.1, 0.05, 0.02}};
+    EXPECT_EQ(parseScene(c, "scene.json", "/scenes").groom.procedural.colors.size(), 2u);
+    c["groom"]["procedural"]["colors"] = nlohmann::json::array();
+    EXPECT_NE(errorOf(c).find("/groom/procedural/colors"), std::string::npos) << errorOf(c);
+    c["groom"]["procedural"]["colors"] = {{0.8, 0.6, 2.0}};
+    EXPECT_NE(errorOf(c).find("/groom/procedural/colors/0"), std::string::npos) << errorOf(c);
+
     j["groom"]["thickness"] = "radius";
     EXPECT_NE(errorOf(j).find("/groom/thickness"), std::string::npos) << errorOf(j);
     j["groom"]["thickness"] = "diameter";

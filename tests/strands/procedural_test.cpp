@@ -115,5 +115,32 @@ TEST(Procedural, InvalidParametersNameTheRange) {
     EXPECT_THROW(generateGroom(p), InputError);
 }
 
+TEST(Procedural, ColoursFollowTheClumpsAndLeaveTheGeometryAlone) {
+    ProceduralGroomParams p;
+    p.strands = 2000;
+    const Groom plain = generateGroom(p);
+    EXPECT_TRUE(plain.color.empty());
+    p.colors = {Rgb(0.8f, 0.6f, 0.4f), Rgb(0.6f, 0.1f, 0.05f), Rgb(0.05f)};
+    const Groom coloured = generateGroom(p);
+    EXPECT_EQ(coloured.points, plain.points);
+    EXPECT_EQ(coloured.strandStart, plain.strandStart);
+    ASSERT_EQ(coloured.color.size(), coloured.pointCount());
+    EXPECT_EQ(coloured.color, generateGroom(p).color); // deterministic
+    int used[3] = {0, 0, 0};
+    for (std::size_t s = 0; s < coloured.strandCount(); ++s) {
+        const Rgb c = coloured.color[coloured.strandStart[s]];
+        for (std::size_t i = coloured.strandStart[s]; i < coloured.strandStart[s + 1]; ++i)
+            ASSERT_EQ(coloured.color[i], c) << "strand " << s << " changes colour";
+        for (int k = 0; k < 3; ++k)
+            used[k] += c == p.colors[std::size_t(k)] ? 1 : 0;
+    }
+    for (int k = 0; k < 3; ++k)
+        EXPECT_GT(used[k], 200) << "colour " << k; // ~1/3 of the strands each
+    p.colors.assign(9, Rgb(0.5f));
+    EXPECT_THROW(generateGroom(p), InputError);
+    p.colors = {Rgb(1.5f, 0.0f, 0.0f)};
+    EXPECT_THROW(generateGroom(p), InputError);
+}
+
 } // namespace
 } // namespace hairvox

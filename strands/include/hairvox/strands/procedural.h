@@ -55,6 +55,11 @@ struct ProceduralGroomParams {
     float curlRadius = 0.006f;     ///< curly: helix radius, m
     float curlPitch = 0.018f;      ///< curly: rise per turn along the centreline, m
     float clumpStrength = 0.35f;   ///< pull towards the clump centre at the tip, [0, 1]
+    /// Optional per-point colours (Groom::color, linear RGB in [0, 1]): each
+    /// clump of strands takes one of these at random — streaks of colour that
+    /// follow the clumps. At most kMaxFiberTypes; empty: no colours. The
+    /// geometry does not depend on them.
+    std::vector<Rgb> colors;
 
     std::uint32_t resolvedPointsPerStrand() const;
     /// Throws InputError with the valid range of the first invalid parameter.
