@@ -219,33 +219,30 @@ RasterSettings rasterSettings(const Scene& scene, const PipelineOptions& options
 
 SceneGroom loadGroom(const Scene& scene) {
     SceneGroom g;
-    if (scene.groom.isProcedural()) {
+    const bool procedural = scene.groom.isProcedural();
+    const std::string source = procedural ? "procedural groom" : scene.groom.file.string();
+    if (procedural) {
         g.groom = generateGroom(scene.groom.procedural);
-        g.palette = resolveColors(g.groom, scene.groom.color, scene.fiber, "procedural groom",
-                                  g.warnings);
-        if (!g.palette.colors.empty())
-            g.notes.push_back(strCat(g.palette.size(), " fiber type(s) from the procedural "
-                                                       "groom's colours: sigma_a replaces the scene's"));
-        return g;
+    } else {
+        LoadedGroom loaded = readGroom(scene.groom.file);
+        g.warnings = std::move(loaded.warnings);
+        if (loaded.sanitized.droppedSegments > 0)
+            g.warnings.push_back(
+                strCat("dropped ", loaded.sanitized.droppedSegments, " zero-length segment(s)"));
+        if (loaded.sanitized.droppedStrands > 0)
+            g.warnings.push_back(
+                strCat("dropped ", loaded.sanitized.droppedStrands, " degenerate strand(s)"));
+        g.groom = std::move(loaded.groom);
     }
-    const std::string source = scene.groom.file.string();
-    LoadedGroom loaded = readGroom(scene.groom.file);
-    g.warnings = std::move(loaded.warnings);
-    if (loaded.sanitized.droppedSegments > 0)
-        g.warnings.push_back(
-            strCat("dropped ", loaded.sanitized.droppedSegments, " zero-length segment(s)"));
-    if (loaded.sanitized.droppedStrands > 0)
-        g.warnings.push_back(
-            strCat("dropped ", loaded.sanitized.droppedStrands, " degenerate strand(s)"));
-    g.groom = std::move(loaded.groom);
     if (std::string note = resolveThickness(g.groom, scene.groom.thickness, scene.fiberScale,
                                             source, g.warnings);
         !note.empty())
         g.notes.push_back(std::move(note));
     g.palette = resolveColors(g.groom, scene.groom.color, scene.fiber, source, g.warnings);
     if (!g.palette.colors.empty())
-        g.notes.push_back(strCat(g.palette.size(), " fiber type(s) from the file's colours (",
-                                 "groom.color \"use\"): sigma_a replaces the scene's"));
+        g.notes.push_back(strCat(g.palette.size(), " fiber type(s) from the ",
+                                 procedural ? "procedural groom's" : "file's",
+                                 " colours (groom.color \"use\"): sigma_a replaces the scene's"));
     else if (!g.groom.color.empty())
         g.notes.push_back("per-point colours ignored (groom.color \"ignore\")");
     if (!g.groom.transparency.empty())
