@@ -8,6 +8,11 @@
 // Cases (issue 5 targets: grid mode ≤ 1 s for one light at every shaded point
 // of a 1920×1080 render; grid ≥ 20× faster than exact at equal footprint):
 //   GridForLight        per-light preparation: rate volume + light-space cache
+//   GridForLightRatboy/voxel_um
+//                       the same on a real groom (data/Ratboy_mohawk.tfx, 11k
+//                       strands, 171k segments) from 2 mm down to 0.5 mm voxels
+//                       (issue 16: time and memory linear in active voxels):
+//                       ns_per_voxel and bytes_per_voxel should stay flat
 //   GridLookup          one cached query (random points on fibers)
 //   GridMarch           one exact march per query (no cache)
 //   ExactRays/K         one query by K Embree rays over a disk of one voxel
@@ -19,6 +24,7 @@
 //                       fibers, three lights (issue 5: ≤ 0.03 and ≤ 0.02)
 #include <hairvox/core/parallel.h>
 #include <hairvox/shading/dual_scattering_tables.h>
+#include <hairvox/strands/groom_io.h>
 #include <hairvox/strands/procedural.h>
 #include <hairvox/transmittance/exact_global_term.h>
 #include <hairvox/transmittance/grid_global_term.h>
@@ -27,6 +33,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include <chrono>
 #include <filesystem>
 #include <memory>
 
@@ -72,6 +79,40 @@ void GridForLight(benchmark::State& state) {
     state.counters["voxel_mm"] = f.grid.info.voxelSize * 1e3;
 }
 BENCHMARK(GridForLight)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+
+void GridForLightRatboy(benchmark::State& state) {
+    const Fixture& f = Fixture::get(); // its crossing table
+    static const Groom groom = readGroom(HAIRVOX_DATA_DIR "/Ratboy_mohawk.tfx").groom;
+    SplatOptions splat;
+    splat.voxelSize = double(state.range(0)) * 1e-6;
+    splat.fiberScale.diameter = 1e-4f;
+    splat.fiberScale.densityMultiplier = 4;
+    const FiberGrid grid = splatStrands(groom, splat);
+    GlobalTermSettings settings;
+    settings.fiberScale = splat.fiberScale;
+    const auto model = makeGridModel(grid, {f.crossings}, settings, {});
+    std::size_t bytes = 0;
+    double seconds = 0;
+    for (auto _ : state) {
+        const auto start = std::chrono::steady_clock::now();
+        bytes = model->forLight(kLight)->memoryBytes();
+        seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
+    const double voxels = double(grid.activeVoxelCount());
+    state.counters["voxels"] = voxels;
+    state.counters["MB_held"] = double(bytes) * 1e-6;
+    state.counters["bytes_per_voxel"] = double(bytes) / voxels;
+    state.counters["ns_per_voxel"] = seconds * 1e9 / double(state.iterations()) / voxels;
+}
+BENCHMARK(GridForLightRatboy)
+    ->Arg(2000)
+    ->Arg(1000)
+    ->Arg(700)
+    ->Arg(500)
+    ->ArgName("voxel_um")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(2);
 
 void queries(benchmark::State& state, const GlobalTermModel& model, std::size_t count) {
     const Fixture& f = Fixture::get();

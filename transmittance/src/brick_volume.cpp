@@ -50,14 +50,19 @@ inline void addSimpson(Lanes& a, const Lanes& f0, const Lanes& fm, const Lanes& 
 
 } // namespace
 
+const Lanes BrickVolume::kZero{};
+
 BrickVolume::BrickVolume(double voxelSize)
     : h_(voxelSize)
     , invH_(static_cast<float>(1.0 / voxelSize))
     , slots_(64, -1) {}
 
 std::size_t BrickVolume::memoryBytes() const {
-    return valueCount_ * sizeof(Lanes) + brickCoord_.capacity() * sizeof(glm::ivec3) +
-           slots_.capacity() * sizeof(std::int64_t);
+    return valueCount_ * sizeof(Lanes) + slotIndex_.capacity() * sizeof(std::uint16_t) +
+           valueBase_.capacity() * sizeof(std::size_t) +
+           cellMask_.capacity() * sizeof(cellMask_[0]) +
+           occupancy_.capacity() * sizeof(std::uint64_t) +
+           brickCoord_.capacity() * sizeof(glm::ivec3) + slots_.capacity() * sizeof(std::int64_t);
 }
 
 std::int64_t BrickVolume::find(const glm::ivec3& b) const {
@@ -112,15 +117,78 @@ void BrickVolume::AlignedDelete::operator()(Lanes* p) const {
     ::operator delete[](p, std::align_val_t(alignof(Lanes)));
 }
 
-void BrickVolume::allocate() {
-    valueCount_ = brickCount_ * std::size_t(kBrickValues);
+std::size_t BrickVolume::occupancyBit(const glm::ivec3& b) const {
+    const glm::ivec3 d = b - brickMin_;
+    const glm::ivec3 n = brickMax_ - brickMin_ + 1;
+    return (std::size_t(d.z) * std::size_t(n.y) + std::size_t(d.y)) * std::size_t(n.x) +
+           std::size_t(d.x);
+}
+
+bool BrickVolume::occupied(const glm::ivec3& b) const {
+    if (glm::any(glm::lessThan(b, brickMin_)) || glm::any(glm::greaterThan(b, brickMax_)))
+        return false;
+    const std::size_t bit = occupancyBit(b);
+    return (occupancy_[bit >> 6] >> (bit & 63)) & 1u;
+}
+
+void BrickVolume::allocateSlots() {
+    if (brickCount_ > 0) {
+        occupancy_.assign(occupancyBit(brickMax_) / 64 + 1, 0);
+        for (const glm::ivec3& b : brickCoord_) {
+            const std::size_t bit = occupancyBit(b);
+            occupancy_[bit >> 6] |= std::uint64_t(1) << (bit & 63);
+        }
+    }
+    slotIndex_.resize(brickCount_ * std::size_t(kBrickValues));
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, brickCount_, 256), [&](const auto& r) {
+        std::fill(slotIndex_.begin() + static_cast<std::ptrdiff_t>(r.begin() * kBrickValues),
+                  slotIndex_.begin() + static_cast<std::ptrdiff_t>(r.end() * kBrickValues),
+                  kAbsent);
+    });
+}
+
+void BrickVolume::allocateValues() {
+    // Each brick numbers its reserved slots in slot order (deterministic for
+    // any thread count), then the bricks' runs are laid end to end.
+    std::vector<std::size_t> counts(brickCount_);
+    cellMask_.assign(brickCount_, {});
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, brickCount_, 64), [&](const auto& r) {
+        for (std::size_t brick = r.begin(); brick != r.end(); ++brick) {
+            std::uint16_t* slots = &slotIndex_[brick * kBrickValues];
+            std::uint16_t next = 0;
+            for (int x = 0; x < kSide; ++x)
+                for (int y = 0; y < kSide; ++y)
+                    for (int z = 0; z < kSide; ++z) {
+                        std::uint16_t& slot = slots[valueIndex(x, y, z)];
+                        if (slot == kAbsent)
+                            continue;
+                        slot = next++;
+                        // The value is a corner of the cells (x − 1 .. x, y − 1 .. y, z − 1 .. z).
+                        for (int cx = std::max(x - 1, 0); cx <= std::min(x, kBrick - 1); ++cx)
+                            for (int cy = std::max(y - 1, 0); cy <= std::min(y, kBrick - 1); ++cy)
+                                for (int cz = std::max(z - 1, 0); cz <= std::min(z, kBrick - 1);
+                                     ++cz)
+                                    cellMask_[brick][std::size_t(cx)] |= std::uint64_t(1)
+                                                                         << (cy * 8 + cz);
+                    }
+            counts[brick] = next;
+        }
+    });
+    valueBase_.resize(brickCount_);
+    valueCount_ = 0;
+    for (std::size_t brick = 0; brick < brickCount_; ++brick) {
+        valueBase_[brick] = valueCount_;
+        valueCount_ += counts[brick];
+    }
     // Lanes is an aggregate (an implicit-lifetime type): raw storage filled
     // with value-initialised Lanes, brick by brick on the threads.
     values_.reset(static_cast<Lanes*>(
-        ::operator new[](valueCount_ * sizeof(Lanes), std::align_val_t(alignof(Lanes)))));
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, brickCount_, 16), [&](const auto& r) {
-        std::uninitialized_value_construct(values_.get() + r.begin() * kBrickValues,
-                                           values_.get() + r.end() * kBrickValues);
+        ::operator new[](std::max<std::size_t>(valueCount_, 1) * sizeof(Lanes),
+                         std::align_val_t(alignof(Lanes)))));
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, brickCount_, 64), [&](const auto& r) {
+        std::uninitialized_value_construct(values_.get() + valueBase_[r.begin()],
+                                           values_.get() + valueBase_[r.end() - 1] +
+                                               counts[r.end() - 1]);
     });
 }
 
@@ -131,7 +199,8 @@ BrickVolume::BrickSet BrickVolume::brickSet(const glm::ivec3& b) const {
     return set;
 }
 
-void BrickVolume::set(const BrickSet& bricks, const glm::ivec3& local, const OpticalDepths& value) {
+template <typename F>
+void BrickVolume::forEachCopy(const BrickSet& bricks, const glm::ivec3& local, F&& f) {
     // The voxel's own brick, and the aprons below for each axis where it is on the low face.
     const int onLowFace = (local.x == 0 ? 4 : 0) | (local.y == 0 ? 2 : 0) | (local.z == 0 ? 1 : 0);
     for (int mask = 0; mask < 8; ++mask) {
@@ -139,9 +208,21 @@ void BrickVolume::set(const BrickSet& bricks, const glm::ivec3& local, const Opt
             continue;
         const glm::ivec3 l =
             local + kBrick * glm::ivec3((mask >> 2) & 1, (mask >> 1) & 1, mask & 1);
-        values_[static_cast<std::size_t>(bricks.brick[mask]) * kBrickValues +
-                static_cast<std::size_t>(valueIndex(l.x, l.y, l.z))] = Lanes::from(value);
+        f(static_cast<std::size_t>(bricks.brick[mask]), valueIndex(l.x, l.y, l.z));
     }
+}
+
+void BrickVolume::reserveVoxel(const BrickSet& bricks, const glm::ivec3& local) {
+    forEachCopy(bricks, local, [&](std::size_t brick, int slot) {
+        slotIndex_[brick * kBrickValues + static_cast<std::size_t>(slot)] = kReserved;
+    });
+}
+
+void BrickVolume::set(const BrickSet& bricks, const glm::ivec3& local, const OpticalDepths& value) {
+    forEachCopy(bricks, local, [&](std::size_t brick, int slot) {
+        const std::uint16_t i = slotIndex_[brick * kBrickValues + static_cast<std::size_t>(slot)];
+        values_[valueBase_[brick] + i] = Lanes::from(value);
+    });
 }
 
 template <typename F>
@@ -166,8 +247,9 @@ void BrickVolume::walkBricks(const Vec3f& O, const Vec3f& dir, float s0, float s
     const GridLine<float> inBricks(O / float(kBrick), dir / float(kBrick));
     traverseCells(inBricks, s0, s1, brickMin_, brickMax_,
                   [&](const glm::ivec3& b, float sEnter, float sExit) {
-                      const std::int64_t brick = find(b);
-                      return brick < 0 || visit(static_cast<std::size_t>(brick), b, sEnter, sExit);
+                      if (!occupied(b))
+                          return true;
+                      return visit(static_cast<std::size_t>(find(b)), b, sEnter, sExit);
                   });
 }
 
@@ -175,7 +257,6 @@ template <typename NextSplit, typename OnPiece>
 void BrickVolume::forEachPiece(std::size_t brick, const glm::ivec3& b, const Vec3f& O,
                                const Vec3f& dir, float sa, float sb, NextSplit&& nextSplit,
                                OnPiece&& onPiece) const {
-    const Lanes* v = &values_[brick * kBrickValues];
     const glm::ivec3 base = kBrick * b;
     // The field is continuous: a piece's end value is the next piece's start value.
     Lanes fStart;
@@ -183,11 +264,16 @@ void BrickVolume::forEachPiece(std::size_t brick, const glm::ivec3& b, const Vec
     traverseCells(GridLine<float>(O, dir), sa, sb, base, base + (kBrick - 1),
                   [&](const glm::ivec3& cell, float s, float sEnd) {
                       const glm::ivec3 l = cell - base;
+                      if (!((cellMask_[brick][std::size_t(l.x)] >> (l.y * 8 + l.z)) & 1u)) {
+                          fStart = Lanes{}; // no corner holds a value
+                          haveStart = true;
+                          return true;
+                      }
                       const Lanes* corner[8];
                       bool any = false;
                       for (int k = 0; k < 8; ++k) {
-                          corner[k] =
-                              &v[valueIndex(l.x + (k >> 2), l.y + ((k >> 1) & 1), l.z + (k & 1))];
+                          corner[k] = &value(brick, valueIndex(l.x + (k >> 2),
+                                                               l.y + ((k >> 1) & 1), l.z + (k & 1)));
                           any = any || corner[k]->v[0] != 0.0f;
                       }
                       if (!any) {
@@ -234,28 +320,48 @@ OpticalDepths BrickVolume::integrate(const Vec3f& origin, const Vec3f& dir, floa
     return sum.depths() * static_cast<float>(h_);
 }
 
-std::size_t BrickVolume::integrateCumulative(const Vec3f& origin, const Vec3f& dir, float tStart,
-                                             float step, float opaqueDepth,
-                                             std::span<Lanes> out) const {
-    if (out.empty())
-        return 0;
+void BrickVolume::integrateCumulative(const Vec3f& origin, const Vec3f& dir, float tStart,
+                                      float step, std::size_t count, float opaqueDepth,
+                                      std::vector<CumulativeSample>& out) const {
+    out.clear();
+    if (count == 0)
+        return;
     const Vec3f O = origin * invH_;
     const float opaqueSum = opaqueDepth * invH_;
     const float sStart = tStart * invH_, sStep = step * invH_;
-    const auto count = out.size();
+    const auto position = [&](std::size_t k) { return sStart + static_cast<float>(k) * sStep; };
     Lanes sum;
     std::size_t next = 0; // the next sample to record
-    // Records every sample at or before s with the running sum (in world units).
+    // Records sample `next` with the running sum (in world units).
+    const auto recordNext = [&] {
+        out.push_back({next++, sum});
+        for (float& lane : out.back().value.v)
+            lane *= static_cast<float>(h_);
+    };
+    // Records every sample from `next` to the last at or before s.
     const auto recordUpTo = [&](float s) {
-        for (; next < count && sStart + static_cast<float>(next) * sStep <= s; ++next) {
-            out[next] = sum;
-            for (float& lane : out[next].v)
-                lane *= static_cast<float>(h_);
-        }
+        while (next < count && position(next) <= s)
+            recordNext();
+    };
+    // Entering a brick at s: the samples since the last brick hold the
+    // current sum. The first of them (which the last brick's exit changed)
+    // and the last (which the brick's first piece interpolates from) are
+    // recorded; those between are skipped.
+    const auto skipTo = [&](float s) {
+        if (next < count && position(next) <= s)
+            recordNext();
+        const float local = std::floor((s - sStart) / sStep);
+        std::size_t k = local > 0 ? std::min(static_cast<std::size_t>(local), count - 1) : 0;
+        while (k > 0 && position(k) > s) // float rounding either side of a sample
+            --k;
+        while (k + 1 < count && position(k + 1) <= s)
+            ++k;
+        next = std::max(next, k);
     };
     bool opaque = false;
-    walkBricks(O, dir, sStart, sStart + static_cast<float>(count - 1) * sStep,
+    walkBricks(O, dir, sStart, position(count - 1),
                [&](std::size_t brick, const glm::ivec3& b, float s, float sExit) {
+                   skipTo(s);
                    recordUpTo(s);
                    // Pieces end at sample positions, where the running sum is recorded.
                    forEachPiece(
@@ -272,10 +378,8 @@ std::size_t BrickVolume::integrateCumulative(const Vec3f& origin, const Vec3f& d
                    opaque = sum.opaque(opaqueSum);
                    return !opaque;
                });
-    if (opaque)
-        return next;
-    recordUpTo(std::numeric_limits<float>::max());
-    return count;
+    if (!opaque && next < count)
+        recordNext(); // the first sample after the last brick: the final value
 }
 
 OpticalDepths BrickVolume::sample(const Vec3f& position) const {
@@ -285,11 +389,11 @@ OpticalDepths BrickVolume::sample(const Vec3f& position) const {
     const std::int64_t brick = find(b);
     if (brick < 0)
         return {};
-    const Lanes* v = &values_[static_cast<std::size_t>(brick) * kBrickValues];
     const glm::ivec3 l = c - kBrick * b;
     const Lanes* corner[8];
     for (int k = 0; k < 8; ++k)
-        corner[k] = &v[valueIndex(l.x + (k >> 2), l.y + ((k >> 1) & 1), l.z + (k & 1))];
+        corner[k] = &value(static_cast<std::size_t>(brick),
+                           valueIndex(l.x + (k >> 2), l.y + ((k >> 1) & 1), l.z + (k & 1)));
     return trilinear(corner, q - Vec3f(c)).depths();
 }
 

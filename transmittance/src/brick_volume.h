@@ -5,10 +5,17 @@
 // Values live at voxel vertices (the fiber grid's vertex-centred convention):
 // voxel (i,j,k) sits at world position (i,j,k)·h and values between voxels are
 // trilinear. Storage is a hash map of bricks of 8³ voxels (the fiber grid's
-// leaf layout) with a one-voxel apron on the +x, +y, +z sides (9³ values), so
+// leaf layout) with a one-voxel apron on the +x, +y, +z sides (9³ slots), so
 // the 8 corners of every cell a brick owns are in that brick: one lookup per
 // brick, none per corner. A value is 8 floats (7 channels and padding) so
 // that the per-cell arithmetic vectorises.
+//
+// Only the slots that hold a value are stored: each brick has a table of 9³
+// 16-bit indices into its own packed run of values (absent slots read zero).
+// Memory therefore follows the active voxels, not the bricks' volume: at fine
+// voxel sizes a strand crosses a brick alone and fills ~5% of it (Ratboy at
+// 0.5 mm: 25 active voxels per 8³ brick), where dense 9³ bricks cost 0.9 KB
+// per active voxel and grew as the square of the resolution.
 #pragma once
 
 #include <hairvox/core/rgb.h>
@@ -16,6 +23,7 @@
 
 #include <glm/vec3.hpp>
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -75,17 +83,25 @@ public:
         std::int64_t brick[8];
     };
 
-    /// Registers brick b and, for each bit of `lowFaces` (4 x, 2 y, 1 z: b
-    /// has values on that low face), the bricks whose aprons hold them. Not
-    /// thread-safe; call for every brick, then allocate(), before any set().
+    /// Building takes five steps, in this order:
+    ///  1. reserveBrick() for every brick (serial): registers brick b and, for
+    ///     each bit of `lowFaces` (4 x, 2 y, 1 z: b has values on that low
+    ///     face), the bricks whose aprons hold them;
+    ///  2. allocateSlots(): the slot tables of every brick, all absent;
+    ///  3. reserveVoxel() for every voxel that will hold a value (thread-safe
+    ///     for distinct voxels);
+    ///  4. allocateValues(): packs each brick's reserved slots and allocates
+    ///     every value at once, zeroed in parallel (pages first touched by
+    ///     the threads that fill them, not faulted in by a growing vector);
+    ///  5. set() for the reserved voxels (thread-safe for distinct voxels).
     void reserveBrick(const glm::ivec3& b, int lowFaces);
-    /// Allocates the values of every reserved brick at once, zeroed in
-    /// parallel (the pages are first touched by the threads that will fill
-    /// them, not faulted in serially by a growing vector).
-    void allocate();
+    void allocateSlots();
     BrickSet brickSet(const glm::ivec3& b) const;
-    /// Stores the value of the voxel at `local` ∈ [0, 8)³ of the brick set's
-    /// brick, in its brick and the aprons below. Thread-safe for distinct voxels.
+    /// Reserves the slots of the voxel at `local` ∈ [0, 8)³ of the brick
+    /// set's brick: in its brick and in the aprons below.
+    void reserveVoxel(const BrickSet& bricks, const glm::ivec3& local);
+    void allocateValues();
+    /// Stores the value of a reserved voxel in its brick and the aprons below.
     void set(const BrickSet& bricks, const glm::ivec3& local, const OpticalDepths& value);
 
 
@@ -95,19 +111,27 @@ public:
     OpticalDepths integrate(const Vec3f& origin, const Vec3f& dir, float tStart, float tEnd,
                             float opaqueDepth, bool& touched) const;
 
-    /// Cumulative integrals along origin + t·dir at t_k = tStart + k·step:
-    /// out[k] = ∫_{tStart}^{t_k}, k = 0 .. out.size() − 1 (out[0] = 0). Stops
-    /// once n and every channel of tauP exceed `opaqueDepth`; returns how many
-    /// entries it filled (the rest would only grow).
-    std::size_t integrateCumulative(const Vec3f& origin, const Vec3f& dir, float tStart, float step,
-                                    float opaqueDepth, std::span<Lanes> out) const;
+    /// One sample of a cumulative integral: ∫_{tStart}^{t_k} at t_k = tStart + k·step.
+    struct CumulativeSample {
+        std::size_t k;
+        Lanes value;
+    };
+    /// Cumulative integrals along origin + t·dir at t_k = tStart + k·step,
+    /// k = 0 .. count − 1, recorded sparsely: `out` gets, in increasing k, the
+    /// samples from the last one before the line enters a brick to the last
+    /// one before it leaves it. A sample not recorded holds the value of the
+    /// one recorded before it (the integral does not change outside bricks),
+    /// and 0 before the first. Stops once n and every channel of tauP exceed
+    /// `opaqueDepth` (later samples would only grow). Work and output follow
+    /// the bricks the line crosses, not its length.
+    void integrateCumulative(const Vec3f& origin, const Vec3f& dir, float tStart, float step,
+                             std::size_t count, float opaqueDepth,
+                             std::vector<CumulativeSample>& out) const;
 
     /// The trilinear value at a world position (zero outside every brick).
     OpticalDepths sample(const Vec3f& position) const;
     /// World-space bounds of every brick.
     Bounds3f bounds() const;
-
-
 
 private:
     /// Calls visit(brickIndex, brickCoord, sEnter, sExit) for the bricks that
@@ -124,8 +148,26 @@ private:
                       float sa, float sb, NextSplit&& nextSplit, OnPiece&& onPiece) const;
     /// Index of the brick at brick coordinate b, or −1.
     std::int64_t find(const glm::ivec3& b) const;
+    /// Whether brick b exists, from the occupancy bits (no hashing): what a
+    /// line's walk asks of every brick position it crosses.
+    bool occupied(const glm::ivec3& b) const;
+    /// Brick b's bit in occupancy_ (b within [brickMin_, brickMax_]).
+    std::size_t occupancyBit(const glm::ivec3& b) const;
     std::int64_t insert(const glm::ivec3& b);
     void grow();
+    /// Calls f(brick, slot) for the slots that hold the voxel at `local` of
+    /// the brick set's brick: its own and those in the aprons below.
+    template <typename F>
+    static void forEachCopy(const BrickSet& bricks, const glm::ivec3& local, F&& f);
+    /// The value in slot `slot` of brick `brick` (zero when the slot is absent).
+    const Lanes& value(std::size_t brick, int slot) const {
+        const std::uint16_t i = slotIndex_[brick * kBrickValues + static_cast<std::size_t>(slot)];
+        return i == kAbsent ? kZero : values_[valueBase_[brick] + i];
+    }
+
+    static constexpr std::uint16_t kAbsent = 0xFFFF;
+    static constexpr std::uint16_t kReserved = 0;
+    static const Lanes kZero;
 
     double h_;
     float invH_;
@@ -135,10 +177,20 @@ private:
     struct AlignedDelete {
         void operator()(Lanes* p) const;
     };
-    /// brickCount_ × kBrickValues, once allocate() has run.
+    /// Per brick, kBrickValues slots: the index of the slot's value in the
+    /// brick's packed run, or kAbsent (kReserved before allocate()).
+    std::vector<std::uint16_t> slotIndex_;
+    std::vector<std::size_t> valueBase_; ///< per brick, its first value in values_
+    /// Per brick, one bit per cell (x·64 + y·8 + z) set where a corner of the
+    /// cell holds a value: a line's walk skips the other cells on one test.
+    std::vector<std::array<std::uint64_t, 8>> cellMask_;
+    /// The packed values of every brick, once allocate() has run.
     std::unique_ptr<Lanes[], AlignedDelete> values_;
     std::size_t valueCount_ = 0;
     glm::ivec3 brickMin_{0}, brickMax_{-1};
+    /// One bit per brick position of [brickMin_, brickMax_] (x fastest), set
+    /// where a brick exists; built by allocateSlots().
+    std::vector<std::uint64_t> occupancy_;
 };
 
 } // namespace hairvox::detail

@@ -34,6 +34,8 @@ public:
         , surfaces_(std::move(surfaces))
         , light_(light) {}
 
+    std::size_t memoryBytes() const override { return inner_->memoryBytes(); }
+
     GlobalTermStats evaluate(std::span<const GlobalTermQuery> queries,
                              std::span<GlobalTerm> out) const override {
         std::vector<GlobalTermQuery> open;

@@ -140,7 +140,17 @@ BrickVolume GridModel::buildRates(const Light& light) const {
         }
         volume.reserveBrick(brickOf(*leaf), lowFaces);
     }
-    volume.allocate();
+    volume.allocateSlots();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size(), 16), [&](const auto& range) {
+        for (std::size_t li = range.begin(); li != range.end(); ++li) {
+            const BrickVolume::BrickSet bricks = volume.brickSet(brickOf(*leaves[li]));
+            for (auto it = leaves[li]->cbeginValueOn(); it; ++it) {
+                const openvdb::Coord l = it.getCoord() - leaves[li]->origin();
+                volume.reserveVoxel(bricks, {l.x(), l.y(), l.z()});
+            }
+        }
+    });
+    volume.allocateValues();
     const float kD = settings_.fiberScale.ribbonWidth();
     const bool tensor = options_.orientation == OrientationModel::Tensor;
     const bool poisson = options_.estimator == AttenuationEstimator::Poisson;
@@ -203,6 +213,10 @@ public:
         // lanes per voxel) are kept only for marching, not for the whole render.
         if (!cache_)
             rates_.emplace(std::move(rates));
+    }
+
+    std::size_t memoryBytes() const override {
+        return cache_ ? cache_->memoryBytes() : rates_->memoryBytes();
     }
 
     GlobalTermStats evaluate(std::span<const GlobalTermQuery> queries,

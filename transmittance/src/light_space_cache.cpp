@@ -86,37 +86,66 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates, 
     const auto samplesPerLine =
         static_cast<std::size_t>(std::ceil((sMaxWorld - cache.sBase_) / cache.h_)) + 2;
 
-    const auto lines = static_cast<std::size_t>(cache.ni_) * static_cast<std::size_t>(cache.nj_);
-    cache.lines_.resize(lines);
-    cache.lineK0_.assign(lines, 0);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, lines, 64), [&](const auto& range) {
-        std::vector<Lanes> buffer(samplesPerLine);
-        for (std::size_t line = range.begin(); line != range.end(); ++line) {
-            Vec3f dir;
-            const Vec3f origin =
-                cache.lineOrigin(static_cast<int>(line % std::size_t(cache.ni_)),
-                                 static_cast<int>(line / std::size_t(cache.ni_)), dir);
-            const std::size_t filled =
-                rates.integrateCumulative(origin, dir, 0.0f, cache.h_, opaqueDepth, buffer);
-            // Keep from the sample before the first non-zero one (zero before).
-            std::size_t first = 0;
-            while (first < filled && buffer[first].v[0] == 0.0f && buffer[first].v[1] == 0.0f)
-                ++first;
-            if (first == filled)
-                continue;
-            first = first > 0 ? first - 1 : 0;
-            // Keep up to the first sample of the final value (unchanged after).
-            std::size_t last = filled;
-            while (last > first + 1 &&
-                   std::equal(std::begin(buffer[last - 2].v), std::end(buffer[last - 2].v),
-                              std::begin(buffer[last - 1].v)))
-                --last;
-            cache.lineK0_[line] = static_cast<std::int32_t>(first);
-            cache.lines_[line].assign(buffer.begin() + static_cast<std::ptrdiff_t>(first),
-                                      buffer.begin() + static_cast<std::ptrdiff_t>(last));
+    const std::size_t lines = cache.lineCount();
+    cache.blocks_.resize((lines + kLinesPerBlock - 1) / kLinesPerBlock);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cache.blocks_.size()), [&](const auto& range) {
+        std::vector<BrickVolume::CumulativeSample> recorded;
+        for (std::size_t bi = range.begin(); bi != range.end(); ++bi) {
+            Block& block = cache.blocks_[bi];
+            const std::size_t first = bi * kLinesPerBlock;
+            const std::size_t end = std::min(first + kLinesPerBlock, lines);
+            block.firstRun.reserve(end - first + 1);
+            for (std::size_t line = first; line != end; ++line) {
+                block.firstRun.push_back(static_cast<std::uint32_t>(block.runs.size()));
+                Vec3f dir;
+                const Vec3f origin = cache.lineOrigin(static_cast<int>(line % std::size_t(cache.ni_)),
+                                                      static_cast<int>(line / std::size_t(cache.ni_)),
+                                                      dir);
+                rates.integrateCumulative(origin, dir, 0.0f, cache.h_, samplesPerLine, opaqueDepth,
+                                          recorded);
+                // Keep the samples at either end of a step where the value changes
+                // (consecutive k); every other sample equals the one kept before it.
+                const auto changes = [&](std::size_t i) {
+                    return recorded[i + 1].k == recorded[i].k + 1 &&
+                           !std::equal(std::begin(recorded[i].value.v), std::end(recorded[i].value.v),
+                                       std::begin(recorded[i + 1].value.v));
+                };
+                bool keptPrevious = false;
+                for (std::size_t i = 0; i < recorded.size(); ++i) {
+                    const bool keep = (i > 0 && changes(i - 1)) || (i + 1 < recorded.size() && changes(i));
+                    if (!keep) {
+                        keptPrevious = false;
+                        continue;
+                    }
+                    if (!keptPrevious || recorded[i].k != recorded[i - 1].k + 1)
+                        block.runs.push_back({static_cast<std::int32_t>(recorded[i].k),
+                                              static_cast<std::uint32_t>(block.samples.size())});
+                    block.samples.push_back(recorded[i].value);
+                    keptPrevious = true;
+                }
+            }
+            block.firstRun.push_back(static_cast<std::uint32_t>(block.runs.size()));
+            block.runs.push_back({0, static_cast<std::uint32_t>(block.samples.size())});
+            block.runs.shrink_to_fit();
+            block.samples.shrink_to_fit();
         }
     });
     return cache;
+}
+
+std::size_t LightSpaceCache::sampleCount() const {
+    std::size_t n = 0;
+    for (const Block& b : blocks_)
+        n += b.samples.size();
+    return n;
+}
+
+std::size_t LightSpaceCache::memoryBytes() const {
+    std::size_t bytes = blocks_.capacity() * sizeof(Block);
+    for (const Block& b : blocks_)
+        bytes += b.firstRun.capacity() * sizeof(std::uint32_t) + b.runs.capacity() * sizeof(Run) +
+                 b.samples.capacity() * sizeof(Lanes);
+    return bytes;
 }
 
 Vec3f LightSpaceCache::toLattice(const Vec3f& p) const {
@@ -140,23 +169,29 @@ Vec3f LightSpaceCache::lineOrigin(int i, int j, Vec3f& dir) const {
 }
 
 Lanes LightSpaceCache::alongLine(std::size_t line, float s) const {
-    const std::vector<Lanes>& samples = lines_[line];
-    if (samples.empty())
-        return {};
-    const float local = s - float(lineK0_[line]);
-    if (local <= 0)
-        return local <= -1.0f ? Lanes{}
-                              : samples.front(); // the first stored sample is the last zero
+    const Block& block = blocks_[line / kLinesPerBlock];
+    const std::size_t j = line % kLinesPerBlock;
+    const std::uint32_t r0 = block.firstRun[j], r1 = block.firstRun[j + 1];
+    if (r0 == r1 || s < float(block.runs[r0].k0))
+        return {}; // before the line's first change: zero
+    // The last run starting at or before s (a line has a few).
+    std::uint32_t r = r0;
+    while (r + 1 < r1 && float(block.runs[r + 1].k0) <= s)
+        ++r;
+    const Run& run = block.runs[r];
+    const std::size_t count = block.runs[r + 1].begin - run.begin;
+    const float local = s - float(run.k0);
     const auto k = static_cast<std::size_t>(local);
-    if (k + 1 >= samples.size())
-        return samples.back(); // past the last brick or opaque: unchanged from here on
+    const Lanes* samples = block.samples.data() + run.begin;
+    if (k + 1 >= count)
+        return samples[count - 1]; // unchanged until the next run (or for good)
     const float t = local - float(k);
     const Lanes& a = samples[k];
     const Lanes& b = samples[k + 1];
-    Lanes r;
+    Lanes result;
     for (int lane = 0; lane < 8; ++lane)
-        r.v[lane] = a.v[lane] + t * (b.v[lane] - a.v[lane]);
-    return r;
+        result.v[lane] = a.v[lane] + t * (b.v[lane] - a.v[lane]);
+    return result;
 }
 
 OpticalDepths LightSpaceCache::lookup(const Vec3f& p) const {

@@ -5,12 +5,16 @@
 // or radiating from a point light that lies outside the volume's bounds (a
 // perspective lattice whose spacing is h at the volume's centre). Each line is
 // integrated exactly once, from the light side, and the running integral is
-// stored every h along it — only from the first brick it enters to the point
-// where it becomes opaque or leaves its last brick (before: zero, after:
-// unchanged). A query interpolates its 4 surrounding lines bilinearly and
-// each line linearly along its length. No value is interpolated twice, so
-// there is no blur that grows with the path; the error is the lattice's
-// interpolation, about a voxel, as in the rate volume itself.
+// stored every h along it — only where it changes: a line keeps runs of
+// samples around the hair it crosses, and between runs (the empty space
+// inside a head or between strands), before its first (zero) and after its
+// last or where it becomes opaque (unchanged), it stores nothing. Memory and
+// build time therefore follow the hair's voxels, not the volume's: at 0.5 mm
+// a line through a mohawk crosses ~1000 lattice steps but changes in ~20. A
+// query interpolates its 4 surrounding lines bilinearly and each line
+// linearly along its length. No value is interpolated twice, so there is no
+// blur that grows with the path; the error is the lattice's interpolation,
+// about a voxel, as in the rate volume itself.
 #pragma once
 
 #include "brick_volume.h"
@@ -34,7 +38,10 @@ public:
     /// The integral from p to the light.
     OpticalDepths lookup(const Vec3f& p) const;
 
-    std::size_t lineCount() const { return lines_.size(); }
+    std::size_t lineCount() const { return std::size_t(ni_) * std::size_t(nj_); }
+    /// Samples stored over every line.
+    std::size_t sampleCount() const;
+    std::size_t memoryBytes() const;
 
 private:
     /// Lattice coordinates of p: (u, v) across the lines, s along them (from the light).
@@ -44,6 +51,20 @@ private:
     /// The stored integral of line `line` at lattice distance s.
     Lanes alongLine(std::size_t line, float s) const;
 
+    /// Samples k0, k0 + 1, ... of a line, stored from `begin` in its block's
+    /// samples up to the next run's begin.
+    struct Run {
+        std::int32_t k0;
+        std::uint32_t begin;
+    };
+    /// The runs of kLinesPerBlock consecutive lines (built by one task).
+    struct Block {
+        std::vector<std::uint32_t> firstRun; ///< per line of the block, and one past the last
+        std::vector<Run> runs;               ///< and a sentinel whose begin is samples.size()
+        std::vector<Lanes> samples;
+    };
+    static constexpr std::size_t kLinesPerBlock = 256;
+
     bool perspective_ = false;
     Vec3f origin_{0.0f};                              ///< light position (perspective) or 0
     Vec3f e1_{1, 0, 0}, e2_{0, 1, 0}, axis_{0, 0, 1}; ///< axis points away from the light
@@ -51,8 +72,7 @@ private:
     float h_ = 1;     ///< spacing along lines (world)
     float sBase_ = 0; ///< world distance of lattice s = 0 from the light plane/point
     int i0_ = 0, j0_ = 0, ni_ = 0, nj_ = 0; ///< line lattice [i0, i0 + ni) × [j0, j0 + nj)
-    std::vector<std::int32_t> lineK0_;      ///< per line, lattice index of its first sample
-    std::vector<std::vector<Lanes>> lines_; ///< per line, its stored samples (built in place)
+    std::vector<Block> blocks_; ///< line l is line l % kLinesPerBlock of block l / kLinesPerBlock
 };
 
 } // namespace hairvox::detail

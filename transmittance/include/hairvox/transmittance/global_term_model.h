@@ -66,6 +66,9 @@ public:
     /// opaque surface): every query would be GlobalTerm::blocked(), so a renderer
     /// skips the light.
     virtual bool blocksEverything() const { return false; }
+    /// Bytes held for this light's queries (the grid modes' light-space cache
+    /// or rate volume; 0 for modes that hold nothing per light).
+    virtual std::size_t memoryBytes() const { return 0; }
 };
 
 /// Inputs every mode shares.
