@@ -1,6 +1,7 @@
 // hairvox render [SCENE.json] [--exr OUT.exr] [--png OUT.png] [-o OUT.exr|OUT.png]
 //                [--integrator dual_scattering|path] [--mode exact|grid|approx]
-//                [--shading-rate fragment|vertex] [--spp N]
+//                [--shading-rate fragment|vertex] [--exr-compression zips|zip|rle|none]
+//                [--spp N]
 //                [--time-limit S] [--seed S] [--continue] [--width W] [--height H]
 //                [--voxel-size V] [--max-memory GIB] [--threads N] [--quiet]
 // Renders a scene (or the embedded default scene) to EXR + PNG and prints the
@@ -29,7 +30,7 @@ namespace {
 struct RenderCommandOptions {
     std::string scene;
     std::string output, exr, png;
-    std::string mode, integrator, shadingRate;
+    std::string mode, integrator, shadingRate, exrCompression;
     std::optional<std::uint32_t> spp;
     std::optional<double> timeLimit;
     std::optional<std::uint64_t> seed;
@@ -137,6 +138,8 @@ void runRender(const RenderCommandOptions& opt) {
         scene.integrator = *kIntegratorNames.parse(opt.integrator);
     if (!opt.shadingRate.empty())
         scene.shadingRate = *kShadingRateNames.parse(opt.shadingRate);
+    if (!opt.exrCompression.empty())
+        scene.output.exrCompression = *kExrCompressionNames.parse(opt.exrCompression);
     if ((opt.spp || opt.timeLimit || opt.seed || opt.continueRun) &&
         scene.integrator != Integrator::Path)
         throw InputError("--spp, --time-limit, --seed and --continue apply to the path integrator "
@@ -198,6 +201,10 @@ void addRenderCommand(CLI::App& app) {
                     "Where the dual-scattering shader is evaluated: fragment or vertex "
                     "(docs/scene.md)")
         ->check(CLI::IsMember(kShadingRateNames.names()));
+    cmd->add_option("--exr-compression", opt->exrCompression,
+                    "EXR compression: zips (default), zip, rle or none (sizes and times in "
+                    "docs/scene.md)")
+        ->check(CLI::IsMember(kExrCompressionNames.names()));
     cmd->add_option("--spp", opt->spp, "Path tracing: samples per pixel [1, 1000000]");
     cmd->add_option("--time-limit", opt->timeLimit,
                     "Path tracing: stop after this many seconds (whole passes) [0, 1e7]");

@@ -574,6 +574,7 @@ void writeExrOutput(const Film& film, const Scene& scene,
     if (!scene.output.exr.empty()) {
         ExrHeader header;
         header.zipLevel = scene.output.exrZipLevel;
+        header.compression = scene.output.exrCompression;
         header.worldToCamera = Camera(scene.camera).worldToCameraMatrix();
         header.attributes = {{"hairvox:scene", scene.name},
                              {"hairvox:integrator", toString(scene.integrator)}};

@@ -339,6 +339,8 @@ OutputSettings parseOutput(JsonObject obj, const std::string& stem) {
         o.toneMap = v.oneOf(kToneMapNames);
     if (const JsonValue v = obj["exr_zip_level"]; v.present())
         o.exrZipLevel = static_cast<int>(v.integer(1, 9));
+    if (const JsonValue v = obj["exr_compression"]; v.present())
+        o.exrCompression = v.oneOf(kExrCompressionNames);
     obj.finish();
     return o;
 }

@@ -4,6 +4,8 @@
 // for memory refused before allocating.
 #include "test_util.h"
 
+#include <hairvox/film/image_file.h>
+
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -190,6 +192,24 @@ TEST(CliRenderOptions, ShadingRateIsChosenOnTheCommandLine) {
     r = test::runHairvox("render " + quoted(file) + " --shading-rate pixel");
     EXPECT_NE(r.exitCode, 0);
     EXPECT_TRUE(contains(r.output, "--shading-rate")) << r.output;
+}
+
+TEST(CliRenderOptions, ExrCompressionIsChosenOnTheCommandLine) {
+    test::TempDir dir;
+    SmallScene scene;
+    scene.output = outputs(dir / "zips.exr", dir / "r.png");
+    const fs::path file = scene.write(dir);
+    auto r = test::runHairvox("render " + quoted(file));
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    r = test::runHairvox("render " + quoted(file) + " --exr " + quoted(dir / "none.exr") +
+                         " --exr-compression none");
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_GT(fs::file_size(dir / "none.exr"), 2 * fs::file_size(dir / "zips.exr"));
+    EXPECT_EQ(readExr(dir / "none.exr").channels, readExr(dir / "zips.exr").channels)
+        << "compression changed pixel values";
+    r = test::runHairvox("render " + quoted(file) + " --exr-compression lzma");
+    EXPECT_NE(r.exitCode, 0);
+    EXPECT_TRUE(contains(r.output, "--exr-compression")) << r.output;
 }
 
 TEST(CliRenderMemory, AbsurdSizeFailsFastWithTheEstimate) {

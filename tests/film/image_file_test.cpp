@@ -17,6 +17,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <thread>
 
 namespace hairvox {
@@ -118,6 +119,31 @@ TEST(ExrFile, ZipLevelTradesSizeAndIsChecked) {
     bad.zipLevel = 0;
     EXPECT_THROW(writeExr(dir / "bad.exr", film, bad), InputError);
     EXPECT_FALSE(std::filesystem::exists(dir / "bad.exr"));
+}
+
+TEST(ExrFile, EveryCompressionIsLosslessAndTradesSize) {
+    // A render-like image: smooth hair over a flat background.
+    Film film(300, 600);
+    FilmLayer& beauty = film.layer(film.addLayer(std::string(Film::kBeauty), 3));
+    for (std::size_t i = 0; i < beauty.data.size(); ++i)
+        beauty.data[i] = (i / 3) % 300 < 150 ? 0.02f : 0.5f + 0.4f * std::sin(0.001f * float(i));
+    test::TempDir dir;
+    std::map<ExrCompression, std::uintmax_t> size;
+    std::vector<float> first;
+    for (const auto& [compression, name] : kExrCompressionNames.entries) {
+        ExrHeader header;
+        header.compression = compression;
+        const auto path = dir / strCat(name, ".exr");
+        writeExr(path, film, header);
+        size[compression] = std::filesystem::file_size(path);
+        const std::vector<float> g = readExr(path).channels.at("G");
+        ASSERT_EQ(g.size(), film.pixelCount());
+        if (first.empty())
+            first = g;
+        EXPECT_EQ(g, first) << name << ": the same half values as every other compression";
+    }
+    EXPECT_LT(size[ExrCompression::Zips], size[ExrCompression::Rle]);
+    EXPECT_LT(size[ExrCompression::Rle], size[ExrCompression::None]);
 }
 
 TEST(ExrFile, KeepsValuesBeyondHalfRange) {

@@ -81,7 +81,8 @@ TEST(Scene, EveryFeatureParses) {
                    {"png", nullptr},
                    {"exposure", 1.5},
                    {"tone_map", "clamp"},
-                   {"exr_zip_level", 6}};
+                   {"exr_zip_level", 6},
+                   {"exr_compression", "rle"}};
     const Scene s = parseScene(j, "scene.json", "/scenes");
     EXPECT_EQ(s.groom.file, std::filesystem::path("/scenes/grooms/a.hair"));
     EXPECT_FLOAT_EQ(s.fiberScale.diameter, 8e-5f);
@@ -98,11 +99,20 @@ TEST(Scene, EveryFeatureParses) {
     EXPECT_EQ(s.exact.rays, 8u);
     EXPECT_EQ(s.exact.seed, 5u);
     EXPECT_EQ(s.output.exrZipLevel, 6);
+    EXPECT_EQ(s.output.exrCompression, ExrCompression::Rle);
     EXPECT_EQ(s.shadingRate, ShadingRate::Vertex);
     EXPECT_TRUE(s.output.png.empty());
     EXPECT_EQ(s.output.toneMap, ToneMap::Clamp);
     j["output"]["exr_zip_level"] = 10;
     EXPECT_THROW(parseScene(j, "scene.json", "/scenes"), InputError);
+    j["output"]["exr_zip_level"] = 1;
+    j["output"]["exr_compression"] = "piz";
+    try {
+        parseScene(j, "scene.json", "/scenes");
+        ADD_FAILURE() << "an unknown compression was accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("exr_compression"), std::string::npos) << e.what();
+    }
 }
 
 TEST(Scene, DirectionalLightPointsTowardTheLightAndIsNormalised) {
