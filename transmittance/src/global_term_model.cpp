@@ -19,7 +19,11 @@ GlobalTerm globalTermFromDepths(float n, const Rgb& tauP, const Rgb& sumBeta2, f
     g.T_s = d_f * max(g.P - Rgb(g.V), Rgb(0.0f));
     // σ_f² conditioned on at least one crossing: E[Σβ̄²] / P(m ≥ 1). As n → 0,
     // 1 − e^{−n} → n and the ratio tends to the mean β̄² of the fibers in front.
-    const float crossed = -std::expm1(-n);
+    // 1 − e^{−n} is 1 − V where that is well conditioned (relative error
+    // < 1e-6 for n ≥ 1/16) and its series below (error < n⁴/120 < 2e-7):
+    // expm1f cost 3% of a 1080p render's CPU time.
+    const float crossed =
+        n >= 0.0625f ? 1.0f - g.V : n * (1.0f - n * (0.5f - n * (1.0f / 6.0f - n / 24.0f)));
     g.sigma2_f = crossed > 0 ? sumBeta2 / crossed : Rgb(0.0f);
     return g;
 }
