@@ -86,17 +86,24 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates, 
     const auto samplesPerLine =
         static_cast<std::size_t>(std::ceil((sMaxWorld - cache.sBase_) / cache.h_)) + 2;
 
+    // Lines are integrated in blocks, one task each, then laid end to end.
+    constexpr std::size_t kLinesPerBlock = 256;
+    struct Block {
+        std::vector<std::uint64_t> lineRuns; ///< per line of the block, into runs
+        std::vector<Run> runs;               ///< begin: into samples
+        std::vector<Lanes> samples;
+    };
     const std::size_t lines = cache.lineCount();
-    cache.blocks_.resize((lines + kLinesPerBlock - 1) / kLinesPerBlock);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cache.blocks_.size()), [&](const auto& range) {
+    std::vector<Block> blocks((lines + kLinesPerBlock - 1) / kLinesPerBlock);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks.size()), [&](const auto& range) {
         std::vector<BrickVolume::CumulativeSample> recorded;
         for (std::size_t bi = range.begin(); bi != range.end(); ++bi) {
-            Block& block = cache.blocks_[bi];
+            Block& block = blocks[bi];
             const std::size_t first = bi * kLinesPerBlock;
             const std::size_t end = std::min(first + kLinesPerBlock, lines);
-            block.firstRun.reserve(end - first + 1);
+            block.lineRuns.reserve(end - first);
             for (std::size_t line = first; line != end; ++line) {
-                block.firstRun.push_back(static_cast<std::uint32_t>(block.runs.size()));
+                block.lineRuns.push_back(block.runs.size());
                 Vec3f dir;
                 const Vec3f origin = cache.lineOrigin(static_cast<int>(line % std::size_t(cache.ni_)),
                                                       static_cast<int>(line / std::size_t(cache.ni_)),
@@ -119,33 +126,42 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates, 
                     }
                     if (!keptPrevious || recorded[i].k != recorded[i - 1].k + 1)
                         block.runs.push_back({static_cast<std::int32_t>(recorded[i].k),
-                                              static_cast<std::uint32_t>(block.samples.size())});
+                                              block.samples.size()});
                     block.samples.push_back(recorded[i].value);
                     keptPrevious = true;
                 }
             }
-            block.firstRun.push_back(static_cast<std::uint32_t>(block.runs.size()));
-            block.runs.push_back({0, static_cast<std::uint32_t>(block.samples.size())});
-            block.runs.shrink_to_fit();
-            block.samples.shrink_to_fit();
         }
     });
+    // Offsets of each block's runs and samples in the whole, then the copies in parallel.
+    std::vector<std::uint64_t> runBase(blocks.size() + 1, 0), sampleBase(blocks.size() + 1, 0);
+    for (std::size_t bi = 0; bi < blocks.size(); ++bi) {
+        runBase[bi + 1] = runBase[bi] + blocks[bi].runs.size();
+        sampleBase[bi + 1] = sampleBase[bi] + blocks[bi].samples.size();
+    }
+    cache.lineRuns_.resize(lines + 1);
+    cache.runs_.resize(runBase.back() + 1);
+    cache.samples_.resize(sampleBase.back());
+    tbb::parallel_for(std::size_t(0), blocks.size(), [&](std::size_t bi) {
+        Block& block = blocks[bi];
+        for (std::size_t j = 0; j < block.lineRuns.size(); ++j)
+            cache.lineRuns_[bi * kLinesPerBlock + j] = runBase[bi] + block.lineRuns[j];
+        for (std::size_t r = 0; r < block.runs.size(); ++r)
+            cache.runs_[runBase[bi] + r] = {block.runs[r].k0, sampleBase[bi] + block.runs[r].begin};
+        std::copy(block.samples.begin(), block.samples.end(),
+                  cache.samples_.begin() + static_cast<std::ptrdiff_t>(sampleBase[bi]));
+        block = Block{}; // freed as soon as copied
+    });
+    cache.lineRuns_[lines] = runBase.back();
+    cache.runs_.back() = {0, sampleBase.back()};
     return cache;
 }
 
-std::size_t LightSpaceCache::sampleCount() const {
-    std::size_t n = 0;
-    for (const Block& b : blocks_)
-        n += b.samples.size();
-    return n;
-}
+std::size_t LightSpaceCache::sampleCount() const { return samples_.size(); }
 
 std::size_t LightSpaceCache::memoryBytes() const {
-    std::size_t bytes = blocks_.capacity() * sizeof(Block);
-    for (const Block& b : blocks_)
-        bytes += b.firstRun.capacity() * sizeof(std::uint32_t) + b.runs.capacity() * sizeof(Run) +
-                 b.samples.capacity() * sizeof(Lanes);
-    return bytes;
+    return lineRuns_.capacity() * sizeof(std::uint64_t) + runs_.capacity() * sizeof(Run) +
+           samples_.capacity() * sizeof(Lanes);
 }
 
 Vec3f LightSpaceCache::toLattice(const Vec3f& p) const {
@@ -169,20 +185,18 @@ Vec3f LightSpaceCache::lineOrigin(int i, int j, Vec3f& dir) const {
 }
 
 Lanes LightSpaceCache::alongLine(std::size_t line, float s) const {
-    const Block& block = blocks_[line / kLinesPerBlock];
-    const std::size_t j = line % kLinesPerBlock;
-    const std::uint32_t r0 = block.firstRun[j], r1 = block.firstRun[j + 1];
-    if (r0 == r1 || s < float(block.runs[r0].k0))
+    const std::uint64_t r0 = lineRuns_[line], r1 = lineRuns_[line + 1];
+    if (r0 == r1 || s < float(runs_[r0].k0))
         return {}; // before the line's first change: zero
     // The last run starting at or before s (a line has a few).
-    std::uint32_t r = r0;
-    while (r + 1 < r1 && float(block.runs[r + 1].k0) <= s)
+    std::uint64_t r = r0;
+    while (r + 1 < r1 && float(runs_[r + 1].k0) <= s)
         ++r;
-    const Run& run = block.runs[r];
-    const std::size_t count = block.runs[r + 1].begin - run.begin;
+    const Run& run = runs_[r];
+    const std::size_t count = runs_[r + 1].begin - run.begin;
     const float local = s - float(run.k0);
     const auto k = static_cast<std::size_t>(local);
-    const Lanes* samples = block.samples.data() + run.begin;
+    const Lanes* samples = samples_.data() + run.begin;
     if (k + 1 >= count)
         return samples[count - 1]; // unchanged until the next run (or for good)
     const float t = local - float(k);

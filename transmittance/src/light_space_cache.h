@@ -51,19 +51,12 @@ private:
     /// The stored integral of line `line` at lattice distance s.
     Lanes alongLine(std::size_t line, float s) const;
 
-    /// Samples k0, k0 + 1, ... of a line, stored from `begin` in its block's
-    /// samples up to the next run's begin.
+    /// Samples k0, k0 + 1, ... of a line, stored from samples_[begin] up to
+    /// the next run's begin.
     struct Run {
         std::int32_t k0;
-        std::uint32_t begin;
+        std::uint64_t begin;
     };
-    /// The runs of kLinesPerBlock consecutive lines (built by one task).
-    struct Block {
-        std::vector<std::uint32_t> firstRun; ///< per line of the block, and one past the last
-        std::vector<Run> runs;               ///< and a sentinel whose begin is samples.size()
-        std::vector<Lanes> samples;
-    };
-    static constexpr std::size_t kLinesPerBlock = 256;
 
     bool perspective_ = false;
     Vec3f origin_{0.0f};                              ///< light position (perspective) or 0
@@ -72,7 +65,9 @@ private:
     float h_ = 1;     ///< spacing along lines (world)
     float sBase_ = 0; ///< world distance of lattice s = 0 from the light plane/point
     int i0_ = 0, j0_ = 0, ni_ = 0, nj_ = 0; ///< line lattice [i0, i0 + ni) × [j0, j0 + nj)
-    std::vector<Block> blocks_; ///< line l is line l % kLinesPerBlock of block l / kLinesPerBlock
+    std::vector<std::uint64_t> lineRuns_; ///< line l's runs are runs_[lineRuns_[l], lineRuns_[l + 1])
+    std::vector<Run> runs_;               ///< and a sentinel whose begin is samples_.size()
+    std::vector<Lanes> samples_;
 };
 
 } // namespace hairvox::detail
