@@ -350,6 +350,8 @@ SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& opti
             if (terms[l]->blocksEverything()) {
                 report.skipped = true;
                 terms[l].reset();
+            } else {
+                report.heldBytes = terms[l]->memoryBytes();
             }
         }
         report.prepareSeconds = secondsSince(start);
@@ -476,7 +478,7 @@ SceneRender renderPathTraced(const Scene& scene, const PipelineOptions& options,
     if (traced.stats.spp > 0) // an image without samples says nothing about what the camera sees
         warnIfNoHairSeen(scene, result.film, &groom, result.warnings);
     for (const Light& light : scene.lights)
-        result.lights.push_back({light.name, light.isDark(), 0.0, {}});
+        result.lights.push_back({light.name, light.isDark(), 0.0, 0, {}});
 
     if (writeFiles && traced.stats.spp > previousSpp) {
         start = Clock::now();
@@ -681,8 +683,9 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
     }
     row("tables", r.times.tables,
         strCat("dual-scattering tables (disk cache), ", r.fiberTypes, " fiber type(s)"));
-    std::uint64_t queries = 0, blocked = 0, empty = 0, skippedLights = 0;
+    std::uint64_t queries = 0, blocked = 0, empty = 0, skippedLights = 0, held = 0;
     for (const LightReport& l : r.lights) {
+        held += l.heldBytes;
         queries += l.stats.queries;
         blocked += l.stats.blockedBySurface;
         empty += l.stats.emptyPaths;
@@ -691,7 +694,8 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
     row("global term", r.times.globalTerm,
         thousands(queries) + " queries; skipped: " + thousands(skippedLights) + " light(s), " +
             thousands(blocked) + " behind surfaces, " + thousands(empty) +
-            " with nothing in front");
+            " with nothing in front" +
+            (held > 0 ? strCat("; ", (held + 500'000) / 1'000'000, " MB held") : std::string()));
     row("raster", r.times.raster,
         thousands(st.fragments) + " fragments; skipped: " + thousands(st.segmentsOutsideView) +
             " segments outside the view, " + thousands(st.segmentTilesBehindSurfaces) +

@@ -138,6 +138,8 @@ struct LightReport {
     std::string name;
     bool skipped = false;      ///< no irradiance, or nothing it can reach: never evaluated
     double prepareSeconds = 0; ///< per-light preparation (the grid mode's cache)
+    /// What the preparation holds for the render (LightGlobalTerm::memoryBytes).
+    std::size_t heldBytes = 0;
     GlobalTermStats stats;
 };
 
