@@ -48,6 +48,16 @@ TEST(TfxFormat, RatboyMohawkFigures) {
     EXPECT_NEAR(size.z, 0.61, 0.01);
 }
 
+TEST(TfxFormat, BearFigures) {
+    // A TressFX 3 file with zero offsets (data/README.md).
+    const LoadedGroom g = readGroom(test::dataDir() / "bear.tfx");
+    EXPECT_EQ(g.groom.strandCount(), 48113u);
+    EXPECT_EQ(g.groom.segmentCount(), 144339u);
+    EXPECT_NEAR(g.groom.totalLength(), 207300.0, 207300.0 * 1e-3);
+    const Vec3f size = g.groom.bounds().extent();
+    EXPECT_NEAR(size.z, 199.37, 0.01);
+}
+
 TEST(TfxFormat, SmallFileWithThicknessAndColour) {
     test::TempDir dir;
     TfxLayout l;
@@ -70,6 +80,54 @@ TEST(TfxFormat, SmallFileWithThicknessAndColour) {
     EXPECT_FLOAT_EQ(g.groom.color[5].r, 0.5f);
 }
 
+/// A TressFX 3 file: the 296-byte header, then float3 positions at
+/// `offsetPositions` (0: right after the header, as AMD's viewer samples have it).
+test::ByteWriter tfx3File(std::uint32_t strands, std::uint32_t perStrand,
+                          std::uint32_t offsetPositions, std::uint32_t offsetThickness) {
+    test::ByteWriter w;
+    w.put(3.0f).put(strands).put(perStrand).put(std::uint32_t(0)).put(std::uint32_t(0));
+    w.zeros(31 * 4);
+    w.put(offsetPositions).put(offsetThickness).zeros(4 * 4).zeros(32 * 4);
+    for (std::uint32_t s = 0; s < strands; ++s)
+        for (std::uint32_t k = 0; k < perStrand; ++k)
+            w.put(float(s)).put(float(k)).put(0.5f);
+    return w;
+}
+
+TEST(TfxFormat, Version3WithZeroOffsetsHasPositionsAfterTheHeader) {
+    test::TempDir dir;
+    tfx3File(3, 4, 0, 0).writeTo(dir / "t3.tfx");
+    const LoadedGroom g = readGroom(dir / "t3.tfx");
+    EXPECT_EQ(g.groom.strandCount(), 3u);
+    EXPECT_EQ(g.groom.pointCount(), 12u);
+    EXPECT_EQ(g.groom.points[6], Vec3f(1, 2, 0.5f));
+    EXPECT_TRUE(g.groom.thickness.empty());
+}
+
+TEST(TfxFormat, Version3WithOffsetsAndThickness) {
+    test::TempDir dir;
+    auto w = tfx3File(2, 2, 296, 296 + 4 * 12);
+    w.put(0.5f).put(2.0f);
+    w.writeTo(dir / "t3.tfx");
+    const LoadedGroom g = readTfxFile(dir / "t3.tfx");
+    EXPECT_EQ(g.groom.points[3], Vec3f(1, 1, 0.5f));
+    EXPECT_EQ(g.groom.thickness, (std::vector<float>{0.5f, 0.5f, 2.0f, 2.0f}));
+}
+
+TEST(TfxFormat, Version3TruncatedOrInsideTheHeader) {
+    test::TempDir dir;
+    test::ByteWriter shortHeader;
+    shortHeader.put(3.0f).zeros(200);
+    shortHeader.writeTo(dir / "a.tfx");
+    EXPECT_NE(readError(dir / "a.tfx").find("a TressFX 3 header is 296"), std::string::npos);
+    tfx3File(2, 4, 100, 0).writeTo(dir / "b.tfx");
+    EXPECT_NE(readError(dir / "b.tfx").find("lies inside the header"), std::string::npos);
+    auto c = tfx3File(2, 4, 0, 0);
+    c.writeTo(dir / "c.tfx");
+    std::filesystem::resize_file(dir / "c.tfx", 296 + 5 * 12);
+    EXPECT_NE(readError(dir / "c.tfx").find("vertex positions"), std::string::npos);
+}
+
 TEST(TfxFormat, TruncatedHeader) {
     test::TempDir dir;
     test::ByteWriter w;
@@ -86,7 +144,7 @@ TEST(TfxFormat, WrongVersionIsWrongMagic) {
     putVertex(w, 0, 0, 0);
     putVertex(w, 0, 1, 0);
     w.writeTo(dir / "t.tfx");
-    EXPECT_NE(readError(dir / "t.tfx").find("not a TressFX 4 file"), std::string::npos);
+    EXPECT_NE(readError(dir / "t.tfx").find("not a TressFX 3 or 4 file"), std::string::npos);
 }
 
 TEST(TfxFormat, PositionsPastEndOfFile) {
