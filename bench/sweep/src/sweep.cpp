@@ -190,8 +190,11 @@ SweepOptions SweepOptions::full(const std::filesystem::path& scenesDir) {
     head.pointsPerStrand = 29;
     head.width = 1920;
     head.height = 1080;
+    BenchScene bear;
+    bear.label = "TressFX bear";
+    bear.file = scenesDir / "bear.json";
     o.scenes = {style("straight", GroomStyle::Straight), wavy, style("curly", GroomStyle::Curly),
-                ratboy, head};
+                ratboy, bear, head};
     o.voxelScales = {4, 2, 1.4, 1, 0.7};
     o.exactRays = {1, 4};
     o.referenceRays = 16;

@@ -224,7 +224,8 @@ struct SweepOptions {
     std::ostream* log = nullptr; ///< one line per job
 
     /// Everything: the straight, wavy (the default scene) and curly grooms
-    /// (1024²), Ratboy_mohawk (`ratboyScene`, 960²) and the 50,000-strand ×
+    /// (1024²), Ratboy_mohawk (`ratboyScene`, 960²), the TressFX bear's fur
+    /// (`bear.json`, 144k segments, 1280²) and the 50,000-strand ×
     /// 29-point wavy head (1.4M segments, 1920×1080); five voxel sizes; exact
     /// with 1 and 4 rays against 16; scaling 10k–1.4M segments at 1920×1080
     /// and 256²–2048²; the model sweep on the default scene, the curly
