@@ -29,6 +29,12 @@ endif()
 # Apply hairvox's warning set to one of its own targets (never to dependencies).
 function(hairvox_target_defaults target)
     target_compile_options(${target} PRIVATE ${HAIRVOX_WARNINGS})
+    # GCC's -O2 vectorises only loops of known trip count ("very cheap"); the
+    # per-fragment loops over a shader's floats run a count known at run time.
+    # Element-wise loops vectorised give the same bits (no reassociation).
+    if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+        target_compile_options(${target} PRIVATE -fvect-cost-model=dynamic)
+    endif()
     if(HAIRVOX_WERROR)
         target_compile_options(${target} PRIVATE -Werror)
     endif()

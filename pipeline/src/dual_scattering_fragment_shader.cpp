@@ -54,11 +54,35 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
     std::vector<GlobalTermQuery> queries(points.size());
     for (std::size_t i = 0; i < points.size(); ++i)
         queries[i] = {points[i].position, points[i].tangent, points[i].strand, true,
-                      fiberTypeAt(fiberType_, points[i].segment)};
+                      fiberTypeAt(fiberType_, points[i].segment), points[i].segment};
     std::vector<GlobalTerm> terms(points.size());
-    std::vector<ShadeResult> radiance(points.size());
     std::int64_t globalTermNanos = 0;
     std::vector<GlobalTermStats> batchStats(lightCount);
+
+    // The points of each fiber type, shaded together per light (one batch
+    // and no index list when the groom has one type).
+    const std::size_t types = shaders_.size();
+    thread_local std::vector<ShadeBatch> batches;
+    thread_local std::vector<std::vector<std::uint32_t>> members;
+    batches.resize(std::max(batches.size(), types));
+    members.resize(std::max(members.size(), types));
+    const auto pointOf = [&](std::size_t type, std::size_t k) {
+        return types == 1 ? k : std::size_t(members[type][k]);
+    };
+    if (types > 1) {
+        for (std::size_t t = 0; t < types; ++t)
+            members[t].clear();
+        for (std::size_t i = 0; i < points.size(); ++i)
+            members[queries[i].fiberType].push_back(static_cast<std::uint32_t>(i));
+    }
+    for (std::size_t t = 0; t < types; ++t) {
+        ShadeBatch& batch = batches[t];
+        batch.reset(types == 1 ? points.size() : members[t].size());
+        for (std::size_t k = 0; k < batch.size(); ++k) {
+            const ShadingPoint& p = points[pointOf(t, k)];
+            batch.setView(k, p.toCamera, p.tangent);
+        }
+    }
 
     for (std::size_t l = 0; l < lightCount; ++l) {
         if (terms_[l]) {
@@ -68,37 +92,44 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
         } else {
             std::fill(terms.begin(), terms.end(), GlobalTerm::blocked());
         }
-        const Light& light = lights_[l];
         for (std::size_t i = 0; i < points.size(); ++i) {
-            const ShadingPoint& p = points[i];
             const GlobalTerm& g = terms[i];
             float* lightOut = out.data() + i * stride + 3 * kRadianceLayers + l * kLightFloats;
             lightOut[0] = g.V;
             lightOut[1] = g.n;
             put(lightOut + 2, g.T_s);
             put(lightOut + 5, safeSqrt(g.sigma2_f));
-            if (!terms_[l] || (g.V == 0 && g.T_s.isBlack()))
-                continue; // no light arrives: nothing to shade
-            const Light::Path path = light.pathFrom(p.position);
-            const ShadeResult r =
-                shaders_[queries[i].fiberType].shade(path.omega, p.toCamera, p.tangent, g);
-            const Rgb e = light.irradiance(path.distance);
-            ShadeResult& sum = radiance[i];
-            sum.directR += e * r.directR;
-            sum.directTT += e * r.directTT;
-            sum.directTRT += e * r.directTRT;
-            sum.backDirect += e * r.backDirect;
-            sum.scatter += e * r.scatter;
+        }
+        if (!terms_[l])
+            continue; // a skipped light contributes nothing
+        const Light& light = lights_[l];
+        for (std::size_t t = 0; t < types; ++t) {
+            ShadeBatch& batch = batches[t];
+            if (light.kind == Light::Kind::Directional) {
+                const Light::Path path = light.pathFrom(Vec3f(0.0f));
+                batch.setIncident(path.omega, light.irradiance(path.distance));
+            } else {
+                for (std::size_t k = 0; k < batch.size(); ++k) {
+                    const Light::Path path = light.pathFrom(points[pointOf(t, k)].position);
+                    batch.setIncident(k, path.omega, light.irradiance(path.distance));
+                }
+            }
+            for (std::size_t k = 0; k < batch.size(); ++k)
+                batch.setGlobalTerm(k, terms[pointOf(t, k)]);
+            shaders_[t].shade(batch);
         }
     }
-    for (std::size_t i = 0; i < points.size(); ++i) {
-        float* o = out.data() + i * stride;
-        const ShadeResult& r = radiance[i];
-        put(o, r.directR);
-        put(o + 3, r.directTT);
-        put(o + 6, r.directTRT);
-        put(o + 9, r.backDirect);
-        put(o + 12, r.scatter);
+    for (std::size_t t = 0; t < types; ++t) {
+        const ShadeBatch& batch = batches[t];
+        for (std::size_t k = 0; k < batch.size(); ++k) {
+            float* o = out.data() + pointOf(t, k) * stride;
+            const ShadeResult r = batch.radiance(k);
+            put(o, r.directR);
+            put(o + 3, r.directTT);
+            put(o + 6, r.directTRT);
+            put(o + 9, r.backDirect);
+            put(o + 12, r.scatter);
+        }
     }
     globalTermNanos_ += globalTermNanos;
     shadeNanos_ += nanosSince(start);

@@ -292,7 +292,11 @@ std::unique_ptr<SceneAssets> loadSceneAssets(const Scene& scene, const PipelineO
     assets->times.tables = secondsSince(start);
 
     start = Clock::now();
-    const GlobalTermSettings settings = globalTermSettings(scene, assets->surfaces);
+    GlobalTermSettings settings = globalTermSettings(scene, assets->surfaces);
+    settings.groom = &assets->groom.groom;
+    GridOptions grid = options.grid;
+    if (scene.fiberSampleSpacing)
+        grid.fiberSampleSpacing = *scene.fiberSampleSpacing;
     switch (scene.globalTermMode) {
     case GlobalTermMode::Exact: {
         ExactOptions exact;
@@ -305,11 +309,11 @@ std::unique_ptr<SceneAssets> loadSceneAssets(const Scene& scene, const PipelineO
     }
     case GlobalTermMode::Grid:
         assets->globalTerm =
-            makeGridModel(*assets->grid, std::move(crossings), settings, options.grid);
+            makeGridModel(*assets->grid, std::move(crossings), settings, grid);
         break;
     case GlobalTermMode::Approx:
         assets->globalTerm =
-            makeApproxModel(*assets->grid, std::move(crossings), settings, options.grid);
+            makeApproxModel(*assets->grid, std::move(crossings), settings, grid);
         break;
     }
     assets->times.globalTerm = secondsSince(start);
@@ -683,16 +687,21 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
     }
     row("tables", r.times.tables,
         strCat("dual-scattering tables (disk cache), ", r.fiberTypes, " fiber type(s)"));
-    std::uint64_t queries = 0, blocked = 0, empty = 0, skippedLights = 0, held = 0;
+    std::uint64_t queries = 0, evaluated = 0, blocked = 0, empty = 0, skippedLights = 0, held = 0;
     for (const LightReport& l : r.lights) {
         held += l.heldBytes;
         queries += l.stats.queries;
+        evaluated += l.stats.evaluated;
         blocked += l.stats.blockedBySurface;
         empty += l.stats.emptyPaths;
         skippedLights += l.skipped ? 1 : 0;
     }
     row("global term", r.times.globalTerm,
-        thousands(queries) + " queries; skipped: " + thousands(skippedLights) + " light(s), " +
+        thousands(queries) + " queries" +
+            (evaluated < queries - blocked
+                 ? strCat(" (", thousands(evaluated), " evaluated, the rest interpolated along fibers)")
+                 : std::string()) +
+            "; skipped: " + thousands(skippedLights) + " light(s), " +
             thousands(blocked) + " behind surfaces, " + thousands(empty) +
             " with nothing in front" +
             (held > 0 ? strCat("; ", (held + 500'000) / 1'000'000, " MB held") : std::string()));

@@ -26,6 +26,7 @@ constexpr Range kFovDegrees{0.1, 170.0};
 constexpr Range kHeadRadius{1e-6, 1e4};
 constexpr Range kAlbedo{0.0, 1.0};
 constexpr Range kVoxelSize{0.0, 1000.0, true};
+constexpr Range kFiberSampleSpacing{0.0, 4.0};
 constexpr std::uint64_t kMaxExactRays = 65536;
 constexpr Range kExactRadius{0.0, 1000.0};
 constexpr Range kBackground{0.0, 1e6};
@@ -409,6 +410,8 @@ void Scene::validate() const {
     }
     if (voxelSize)
         requireInRange("grid.voxel_size", *voxelSize, kVoxelSize);
+    if (fiberSampleSpacing)
+        requireInRange("grid.fiber_sample_spacing", *fiberSampleSpacing, kFiberSampleSpacing);
     if (exact.rays < 1 || exact.rays > kMaxExactRays)
         throw InputError(strCat("global_term.exact.rays = ", exact.rays,
                                 ": expected an integer in [1, ", kMaxExactRays, "]"));
@@ -462,6 +465,8 @@ Scene parseScene(const nlohmann::json& document, const std::string& sourceName,
             scene.voxelSize = s.numberF(kVoxelSize);
         else if (s.present() && s.string() != "auto")
             s.failExpected(strCat("\"auto\" or a number ", kVoxelSize.describe()));
+        if (const JsonValue s = grid["fiber_sample_spacing"]; s.present())
+            scene.fiberSampleSpacing = s.numberF(kFiberSampleSpacing);
         grid.finish();
     }
     if (const JsonValue v = root["global_term"]; v.present()) {

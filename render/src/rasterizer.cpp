@@ -317,6 +317,8 @@ struct TileScratch {
     std::vector<std::uint32_t> pixelStart, cursor;
     std::vector<PixelState> pixels;
     std::vector<Visible> visible;
+    std::vector<Visible> grouped;            ///< visible, ordered by segment
+    std::vector<std::uint32_t> segmentStart; ///< per local segment: its first grouped fragment
     std::vector<std::uint32_t> vertexSlot; ///< per local segment: slot of its root-side vertex
     std::vector<std::uint32_t> slotPoint;  ///< per vertex slot: the point index
     std::vector<std::uint32_t> slotStrand; ///< per vertex slot: its strand
@@ -334,20 +336,19 @@ struct TileResult {
     std::vector<std::string> warnings;
 };
 
-/// Finite and not negative (−0 included): one integer comparison on the bits.
-bool finiteNonNegative(float x) {
-    const auto bits = std::bit_cast<std::uint32_t>(x);
-    return bits < 0x7f800000u || bits == 0x80000000u;
-}
-
-/// Radiance finite and non-negative, averages finite.
+/// Radiance finite and non-negative, averages finite. Branch-free integer
+/// tests on the bits, or-ed together, so that the loops vectorise: every
+/// fragment's results pass through here.
 bool isValid(std::span<const float> r, std::size_t radianceFloats) {
-    bool ok = true;
-    for (std::size_t i = 0; i < radianceFloats; ++i)
-        ok = ok && finiteNonNegative(r[i]);
+    std::uint32_t bad = 0;
+    for (std::size_t i = 0; i < radianceFloats; ++i) {
+        // Finite and not negative: below 0x7f800000, or −0.
+        const std::uint32_t bits = std::bit_cast<std::uint32_t>(r[i]);
+        bad |= std::uint32_t(bits >= 0x7f800000u) & std::uint32_t(bits != 0x80000000u);
+    }
     for (std::size_t i = radianceFloats; i < r.size(); ++i)
-        ok = ok && std::isfinite(r[i]);
-    return ok;
+        bad |= std::uint32_t((std::bit_cast<std::uint32_t>(r[i]) & 0x7f800000u) == 0x7f800000u);
+    return bad == 0;
 }
 
 /// Renders one tile.
@@ -638,10 +639,12 @@ private:
     }
 
     /// Adds a shaded fragment to its pixel's sums.
-    void accumulate(const Visible& v, const float* r) {
-        float* sum = s_.pixelSum.data() + std::size_t(v.pixel) * stride_;
+    void accumulate(const Visible& v, const float* __restrict r) {
+        // restrict: the sums and the results never overlap, so the loop vectorises.
+        float* __restrict sum = s_.pixelSum.data() + std::size_t(v.pixel) * stride_;
+        const float w = v.weight;
         for (std::size_t k = 0; k < stride_; ++k)
-            sum[k] += v.weight * r[k];
+            sum[k] += w * r[k];
     }
 
     std::string pixelName(std::uint32_t pixel) const {
@@ -649,8 +652,25 @@ private:
                       y0_ + int(pixel / std::uint32_t(width_)), ")");
     }
 
+    /// Orders the visible fragments by segment (a stable counting sort):
+    /// the points of a batch then come segment by segment, which lets a
+    /// shader share work along a segment (the global term's fiber samples,
+    /// transmittance/alongFibers()) and the segment's data between points.
+    void groupVisibleBySegment() {
+        s_.segmentStart.assign(bins_.size() + 1, 0);
+        for (const Visible& v : s_.visible)
+            ++s_.segmentStart[v.local + 1];
+        for (std::size_t i = 0; i < bins_.size(); ++i)
+            s_.segmentStart[i + 1] += s_.segmentStart[i];
+        s_.grouped.resize(s_.visible.size());
+        for (const Visible& v : s_.visible)
+            s_.grouped[s_.segmentStart[v.local]++] = v;
+        s_.visible.swap(s_.grouped);
+    }
+
     void shadeFragments() {
         s_.pixelSum.assign(std::size_t(area_) * stride_, 0.0f);
+        groupVisibleBySegment();
         for (std::size_t begin = 0; begin < s_.visible.size(); begin += kShadeBatch) {
             const std::size_t count = std::min(kShadeBatch, s_.visible.size() - begin);
             s_.points.resize(count);

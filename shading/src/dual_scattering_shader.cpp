@@ -1,10 +1,14 @@
+#include "shade_kernel.h"
+
 #include <hairvox/core/error.h>
 #include <hairvox/core/math.h>
 #include <hairvox/shading/dual_scattering_shader.h>
-#include <hairvox/shading/longitudinal.h>
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
+#include <span>
 #include <stdexcept>
 
 namespace hairvox {
@@ -35,61 +39,143 @@ DualScatteringShader::DualScatteringShader(const MarschnerBcsdf& bcsdf,
                                            tables.params(), " used with ", bcsdf.params()));
 }
 
-DualScatteringShader::Backscatter DualScatteringShader::backscatter(float theta_i) const {
-    using S = DualScatteringTables::Sample;
-    const auto [ABar_b, DeltaBar_b, sigma2Bar_b] =
-        tables_.interpolate(theta_i, &S::ABar_b, &S::DeltaBar_b, &S::sigma2Bar_b);
-    return {ABar_b, DeltaBar_b, sigma2Bar_b};
+namespace {
+
+detail::ShadeKernelParams kernelParams(const DualScatteringShader& shader) {
+    return {detail::marschnerView(shader.bcsdf()), detail::tablesView(shader.tables()),
+            shader.params().d_b};
 }
 
-Rgb DualScatteringShader::fBack(const FiberAngles& a, const Backscatter& b,
-                                const Rgb& sigma2) const {
-    const float azimuthal = 0.5f * std::max(a.cosPhi, 0.0f);
-    if (azimuthal == 0)
-        return Rgb(0.0f);
-    const Rgb longitudinal =
-        longitudinalLobe(Rgb(a.theta_h) - b.DeltaBar_b, b.sigma2Bar_b + sigma2);
-    return b.ABar_b * longitudinal * (azimuthal / a.cos2Theta_d);
+/// The shader at one point given by its angles: ShadeResult's 15 floats,
+/// then f_s^scatter(σ_f²) and f_back(σ_f²).
+std::array<float, detail::kShadeRows + detail::kShadeTermRows>
+shadeOneAngle(const DualScatteringShader& shader, const FiberAngles& a, const GlobalTerm& g) {
+    using detail::kBatchAlignment;
+    const auto angles = std::bit_cast<std::array<float, detail::kAngleRows>>(a);
+    const std::array<float, detail::kGlobalTermRows> term{
+        g.V, g.T_s.r, g.T_s.g, g.T_s.b, g.sigma2_f.r, g.sigma2_f.g, g.sigma2_f.b};
+    std::array<float, detail::kAngleRows * kBatchAlignment> in{};
+    std::array<float, detail::kGlobalTermRows * kBatchAlignment> terms{};
+    std::array<float, (detail::kShadeRows + detail::kShadeTermRows) * kBatchAlignment> out;
+    for (std::size_t r = 0; r < angles.size(); ++r)
+        in[r * kBatchAlignment] = angles[r];
+    for (std::size_t r = 0; r < term.size(); ++r)
+        terms[r * kBatchAlignment] = term[r];
+    detail::shadeAngles(kernelParams(shader), {1, kBatchAlignment, in.data()},
+                        {1, kBatchAlignment, terms.data()}, {1, kBatchAlignment, out.data()}, true);
+    std::array<float, detail::kShadeRows + detail::kShadeTermRows> result;
+    for (std::size_t r = 0; r < result.size(); ++r)
+        result[r] = out[r * kBatchAlignment];
+    return result;
 }
 
-Rgb DualScatteringShader::fBack(const FiberAngles& a, const Rgb& sigma2) const {
-    return fBack(a, backscatter(a.theta_i), sigma2);
+Rgb rgbAt(std::span<const float> values, std::size_t first) {
+    return {values[first], values[first + 1], values[first + 2]};
 }
 
-Rgb DualScatteringShader::fsScatter(const FiberAngles& a, const Rgb& sigma2_f) const {
-    const LobeValues ng = tables_.NG(a.theta_d, a.phi);
-    Rgb sum(0.0f);
-    for (Lobe p : kLobes) {
-        const float beta = bcsdf_.beta(p);
-        sum +=
-            ng[p] * longitudinalLobe(Rgb(a.theta_h - bcsdf_.alpha(p)), Rgb(beta * beta) + sigma2_f);
+ShadeResult shadeResultOf(std::span<const float> v) {
+    return {rgbAt(v, 0), rgbAt(v, 3), rgbAt(v, 6), rgbAt(v, 9), rgbAt(v, 12)};
+}
+
+} // namespace
+
+namespace {
+constexpr std::size_t kGlobalTermRow = detail::kDirectionRows;
+constexpr std::size_t kIrradianceRow = kGlobalTermRow + detail::kGlobalTermRows;
+} // namespace
+
+void ShadeBatch::reset(std::size_t count) {
+    static_assert(kInputRows == kIrradianceRow + 3 && kOutputRows == detail::kShadeRows);
+    count_ = count;
+    // Whole vectors, plus one: rows a power of two apart (1024 points: 4 KiB)
+    // would all map to the same L1 cache sets and evict each other.
+    const std::size_t capacity =
+        ((count + detail::kBatchAlignment - 1) / detail::kBatchAlignment + 1) * detail::kBatchAlignment;
+    if (capacity != capacity_) {
+        capacity_ = capacity;
+        // Zeros in the padding: the kernel reads whole vectors.
+        inputs_.assign(kInputRows * capacity_, 0.0f);
+        radiance_.resize(kOutputRows * capacity_);
     }
-    return sum * (1.0f / a.cos2Theta_d);
+    std::fill(radiance_.begin(), radiance_.end(), 0.0f);
+}
+
+void ShadeBatch::setView(std::size_t i, const Vec3f& wo, const Vec3f& u) {
+    for (int c = 0; c < 3; ++c) {
+        const auto uc = static_cast<std::size_t>(c);
+        in(detail::kWoX + uc, i) = wo[c];
+        in(detail::kUX + uc, i) = u[c];
+    }
+}
+
+void ShadeBatch::setIncident(std::size_t i, const Vec3f& wi, const Rgb& E) {
+    for (int c = 0; c < 3; ++c) {
+        const auto uc = static_cast<std::size_t>(c);
+        in(detail::kWiX + uc, i) = wi[c];
+        in(kIrradianceRow + uc, i) = E[c];
+    }
+}
+
+void ShadeBatch::setIncident(const Vec3f& wi, const Rgb& E) {
+    for (int c = 0; c < 3; ++c) {
+        const auto uc = static_cast<std::size_t>(c);
+        std::fill_n(&in(detail::kWiX + uc, 0), count_, wi[c]);
+        std::fill_n(&in(kIrradianceRow + uc, 0), count_, E[c]);
+    }
+}
+
+void ShadeBatch::setGlobalTerm(std::size_t i, const GlobalTerm& g) {
+    in(kGlobalTermRow + detail::kV, i) = g.V;
+    for (int c = 0; c < 3; ++c) {
+        const auto uc = static_cast<std::size_t>(c);
+        in(kGlobalTermRow + detail::kTsR + uc, i) = g.T_s[c];
+        in(kGlobalTermRow + detail::kSigma2R + uc, i) = g.sigma2_f[c];
+    }
+}
+
+ShadeResult ShadeBatch::radiance(std::size_t i) const {
+    std::array<float, kOutputRows> v;
+    for (std::size_t r = 0; r < kOutputRows; ++r)
+        v[r] = radiance_[r * capacity_ + i];
+    return shadeResultOf(v);
+}
+
+void DualScatteringShader::shade(ShadeBatch& batch) const {
+    if (batch.count_ == 0)
+        return;
+    const std::size_t n = batch.count_, capacity = batch.capacity_;
+    const float* in = batch.inputs_.data();
+    detail::shadeDirections(kernelParams(*this), {n, capacity, in},
+                            {n, capacity, in + kGlobalTermRow * capacity},
+                            {n, capacity, in + kIrradianceRow * capacity},
+                            {n, capacity, batch.radiance_.data()});
+}
+
+ShadeResult DualScatteringShader::shade(const Vec3f& wi, const Vec3f& wo, const Vec3f& u,
+                                        const GlobalTerm& g) const {
+    ShadeBatch batch;
+    batch.reset(1);
+    batch.setView(0, wo, u);
+    batch.setIncident(0, wi, Rgb(1.0f));
+    batch.setGlobalTerm(0, g);
+    shade(batch);
+    return batch.radiance(0);
 }
 
 ShadeResult DualScatteringShader::shade(const FiberAngles& a, const GlobalTerm& g) const {
-    ShadeResult r;
-    // Components whose weight is zero are not computed (DESIGN.md §7).
-    const bool direct = g.V > 0, scatter = !g.T_s.isBlack();
-    if (a.cosTheta_i <= 0 || !(direct || scatter))
-        return r;
-    const Backscatter b = backscatter(a.theta_i);
-    if (direct) {
-        const float w = g.V * a.cosTheta_i;
-        const LobeValues f = bcsdf_.eval(a);
-        r.directR = f.R * w;
-        r.directTT = f.TT * w;
-        r.directTRT = f.TRT * w;
-        r.backDirect = fBack(a, b, Rgb(0.0f)) * (params_.d_b * w);
-    }
-    if (scatter) {
-        const Rgb sigma2_f = max(g.sigma2_f, Rgb(0.0f));
-        r.scatter = g.T_s *
-                    (fsScatter(a, sigma2_f) +
-                     static_cast<float>(Pi) * params_.d_b * fBack(a, b, sigma2_f)) *
-                    a.cosTheta_i;
-    }
-    return r;
+    return shadeResultOf(shadeOneAngle(*this, a, g));
+}
+
+Rgb DualScatteringShader::fBack(const FiberAngles& a, const Rgb& sigma2) const {
+    GlobalTerm g;
+    g.sigma2_f = sigma2;
+    return rgbAt(shadeOneAngle(*this, a, g), detail::kShadeRows + 3);
+}
+
+Rgb DualScatteringShader::fsScatter(const FiberAngles& a, const Rgb& sigma2_f) const {
+    GlobalTerm g;
+    g.sigma2_f = sigma2_f;
+    return rgbAt(shadeOneAngle(*this, a, g), detail::kShadeRows);
 }
 
 } // namespace hairvox

@@ -1,4 +1,5 @@
 #include "gauss_legendre.h"
+#include "shade_kernel.h"
 
 #include <hairvox/core/atomic_file.h>
 #include <hairvox/core/error.h>
@@ -13,6 +14,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstddef>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -361,6 +363,28 @@ LobeValues DualScatteringTables::NG(float theta_d, float phi) const {
     }
     return v;
 }
+
+namespace detail {
+
+DualScatteringTablesView tablesView(const DualScatteringTables& tables) {
+    // The kernel reads Sample and LobeValues as arrays of floats.
+    using Sample = DualScatteringTables::Sample;
+    constexpr auto floats = [](std::size_t bytes) { return static_cast<int>(bytes / sizeof(float)); };
+    static_assert(floats(sizeof(Sample)) == kSampleFloats && floats(sizeof(LobeValues)) == kLobeRows);
+    static_assert(floats(offsetof(Sample, ABar_b)) == kSampleABar_b &&
+                  floats(offsetof(Sample, DeltaBar_b)) == kSampleDeltaBar_b &&
+                  floats(offsetof(Sample, sigma2Bar_b)) == kSampleSigma2Bar_b);
+    static_assert(DualScatteringTables::kNGPhiSamples == kNGPhiNodes);
+    DualScatteringTablesView v;
+    v.rows = &tables.rows_.front().aBar_f.r;
+    v.ng = &tables.ng_.front().R.r;
+    v.rowCount = static_cast<int>(tables.rows_.size());
+    v.invStep = tables.invStep_;
+    v.lastIndex = tables.lastIndex_;
+    return v;
+}
+
+} // namespace detail
 
 DualScatteringTables DualScatteringTables::withBackwardDensity(float d_b) const {
     DualScatteringTables t = *this;

@@ -1,5 +1,5 @@
-#include "fast_math.h"
 #include "gauss_legendre.h"
+#include "shade_kernel.h"
 
 #include <hairvox/core/math.h>
 #include <hairvox/shading/azimuthal.h>
@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <vector>
 
@@ -84,41 +85,19 @@ std::ostream& operator<<(std::ostream& os, const LobeValues& v) {
 }
 
 FiberAngles FiberAngles::fromDirections(const Vec3f& wi, const Vec3f& wo, const Vec3f& u) {
-    FiberAngles a;
-    a.sinTheta_i = std::clamp(glm::dot(wi, u), -1.0f, 1.0f);
-    a.sinTheta_o = std::clamp(glm::dot(wo, u), -1.0f, 1.0f);
-    a.cosTheta_i = fast::cosFromSin(a.sinTheta_i);
-    a.cosTheta_o = fast::cosFromSin(a.sinTheta_o);
-    a.theta_i = fast::asin(a.sinTheta_i);
-    a.theta_o = fast::asin(a.sinTheta_o);
-    a.theta_h = 0.5f * (a.theta_i + a.theta_o);
-    a.theta_d = 0.5f * (a.theta_o - a.theta_i);
-    // cos²θ_d = (1 + cos(θ_o − θ_i))/2 without another trigonometric call.
-    a.cos2Theta_d = std::max(
-        0.5f * (1.0f + a.cosTheta_i * a.cosTheta_o + a.sinTheta_i * a.sinTheta_o), kMinCos2Theta_d);
-    // u·(ω_i × ω_o) and ω_i·ω_o − sin θ_i sin θ_o are |ω_i⊥||ω_o⊥| sin φ and
-    // |ω_i⊥||ω_o⊥| cos φ (the components along u drop out).
-    const float sinPhi = glm::dot(u, glm::cross(wi, wo));
-    const float cosPhi = glm::dot(wi, wo) - a.sinTheta_i * a.sinTheta_o;
-    const float r2 = sinPhi * sinPhi + cosPhi * cosPhi;
-    if (r2 > 0) {
-        const float invR = 1.0f / std::sqrt(r2);
-        a.cosPhi = std::clamp(cosPhi * invR, -1.0f, 1.0f);
-        // |φ| from whichever of asin(|sin φ|), acos(cos φ) is well conditioned:
-        // one asin instead of atan2, same precision.
-        const bool nearHalfPi = std::abs(a.cosPhi) < 0.7f;
-        const float r = fast::asin(nearHalfPi ? a.cosPhi : std::min(std::abs(sinPhi) * invR, 1.0f));
-        a.phi = std::copysign(nearHalfPi ? kPiOver2 - r : (a.cosPhi > 0 ? r : kPi - r), sinPhi);
-    }
-    const float den = a.cosTheta_i * a.cosTheta_o;
-    if (den > 0) {
-        Vec3f s, t;
-        coordinateSystem(u, s, t);
-        a.cos2Phi_h = std::clamp(
-            (glm::dot(wi, s) * glm::dot(wo, s) - glm::dot(wi, t) * glm::dot(wo, t)) / den, -1.0f,
-            1.0f);
-    }
-    return a;
+    // A batch of one through the kernel: the renderer's batches run the same code.
+    using detail::kBatchAlignment;
+    std::array<float, detail::kDirectionRows * kBatchAlignment> in{};
+    std::array<float, detail::kAngleRows * kBatchAlignment> out;
+    const std::array<const Vec3f*, 3> vectors{&wi, &wo, &u};
+    for (std::size_t v = 0; v < 3; ++v)
+        for (int c = 0; c < 3; ++c)
+            in[(3 * v + std::size_t(c)) * kBatchAlignment] = (*vectors[v])[c];
+    detail::anglesFromDirections({1, kBatchAlignment, in.data()}, {1, kBatchAlignment, out.data()});
+    std::array<float, detail::kAngleRows> fields;
+    for (std::size_t r = 0; r < fields.size(); ++r)
+        fields[r] = out[r * kBatchAlignment];
+    return std::bit_cast<FiberAngles>(fields);
 }
 
 FiberAngles FiberAngles::fromAngles(float theta_i, float theta_o, float phi, float phi_h) {
@@ -396,8 +375,34 @@ LobeValues MarschnerBcsdf::withLongitudinal(LobeValues n, const FiberAngles& a) 
 }
 
 LobeValues MarschnerBcsdf::eval(const FiberAngles& a) const {
-    return withLongitudinal(table_->lookup(std::sqrt(a.cos2Theta_d), a.phi, a.cos2Phi_h), a);
+    using detail::kBatchAlignment;
+    const auto fields = std::bit_cast<std::array<float, detail::kAngleRows>>(a);
+    std::array<float, detail::kAngleRows * kBatchAlignment> in{};
+    std::array<float, detail::kLobeRows * kBatchAlignment> out;
+    for (std::size_t r = 0; r < fields.size(); ++r)
+        in[r * kBatchAlignment] = fields[r];
+    detail::evalMarschner(detail::marschnerView(*this), {1, kBatchAlignment, in.data()},
+                          {1, kBatchAlignment, out.data()});
+    const auto at = [&](std::size_t r) { return out[r * kBatchAlignment]; };
+    return {Rgb(at(0), at(1), at(2)), Rgb(at(3), at(4), at(5)), Rgb(at(6), at(7), at(8))};
 }
+
+namespace detail {
+
+MarschnerView marschnerView(const MarschnerBcsdf& bcsdf) {
+    MarschnerView v;
+    for (std::size_t p = 0; p < 3; ++p) {
+        v.alpha[p] = bcsdf.alpha_[p];
+        v.variance[p] = bcsdf.beta_[p] * bcsdf.beta_[p];
+        v.scale[p] = std::sqrt(1.0f / (static_cast<float>(8.0 * Pi) * v.variance[p]));
+        v.invTwoVariance[p] = 0.5f / v.variance[p];
+    }
+    const MarschnerBcsdf::AzimuthalTable& t = *bcsdf.table_;
+    v.N = {t.rtt.data(), t.trt.data(), t.thetaCount, t.phiCount, t.eccCount, t.phiScale};
+    return v;
+}
+
+} // namespace detail
 
 LobeValues MarschnerBcsdf::evalExact(const FiberAngles& a) const {
     return withLongitudinal(NExact(a.theta_d, a.phi, a.cos2Phi_h), a);

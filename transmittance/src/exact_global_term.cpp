@@ -143,6 +143,7 @@ GlobalTermStats ExactLightGlobalTerm::evaluate(std::span<const GlobalTermQuery> 
                       });
     GlobalTermStats stats;
     stats.queries = queries.size();
+    stats.evaluated = queries.size();
     return stats;
 }
 

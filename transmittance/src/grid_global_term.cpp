@@ -31,6 +31,9 @@ void GridOptions::validate(const FiberGrid& grid) const {
     if (!(cacheSpacing >= 0.5f && cacheSpacing <= 4))
         throw InputError(strCat("grid cache spacing = ", cacheSpacing,
                                 " voxels should be in the range [0.5, 4]"));
+    if (!(fiberSampleSpacing >= 0 && fiberSampleSpacing <= 4))
+        throw InputError(strCat("grid fiber sample spacing = ", fiberSampleSpacing,
+                                " voxels should be in the range [0, 4] (0: every point)"));
     if (orientation == OrientationModel::Tensor && !grid.hasTensor())
         throw InputError("the tensor orientation model needs a fiber grid with the orientation "
                          "tensor (voxelize --orientation-tensor)");
@@ -43,7 +46,8 @@ std::ostream& operator<<(std::ostream& os, const GridOptions& options) {
               << ", estimator=" << toString(options.estimator)
               << ", evaluation=" << toString(options.evaluation)
               << ", startOffset=" << options.startOffset
-              << " voxels, cacheSpacing=" << options.cacheSpacing << " voxels)";
+              << " voxels, cacheSpacing=" << options.cacheSpacing
+              << " voxels, fiberSampleSpacing=" << options.fiberSampleSpacing << " voxels)";
 }
 
 namespace {
@@ -202,6 +206,9 @@ BrickVolume GridModel::buildRates(const Light& light) const {
 
 class GridLightGlobalTerm final : public LightGlobalTerm {
 public:
+    /// Batches up to this size are evaluated on the calling thread.
+    static constexpr std::size_t kSerialQueries = 4096;
+
     GridLightGlobalTerm(const GridModel& model, const Light& light)
         : model_(model)
         , light_(light) {
@@ -222,16 +229,22 @@ public:
     GlobalTermStats evaluate(std::span<const GlobalTermQuery> queries,
                              std::span<GlobalTerm> out) const override {
         std::vector<unsigned char> empty(queries.size(), 0);
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, queries.size(), 64),
-                          [&](const tbb::blocked_range<std::size_t>& range) {
-                              for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                                  bool touched = false;
-                                  out[i] = evaluateOne(queries[i], touched);
-                                  empty[i] = touched ? 0 : 1;
-                              }
-                          });
+        const auto evaluateRange = [&](const tbb::blocked_range<std::size_t>& range) {
+            for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                bool touched = false;
+                out[i] = evaluateOne(queries[i], touched);
+                empty[i] = touched ? 0 : 1;
+            }
+        };
+        // A renderer's batches (~1k points) come from threads that are busy
+        // already: spawning tasks for them costs more than it shares.
+        const tbb::blocked_range<std::size_t> all(0, queries.size(), 64);
+        if (queries.size() <= kSerialQueries)
+            evaluateRange(all);
+        else
+            tbb::parallel_for(all, evaluateRange);
         GlobalTermStats stats;
-        stats.queries = queries.size();
+        stats.queries = stats.evaluated = queries.size();
         for (unsigned char e : empty)
             stats.emptyPaths += e;
         return stats;
@@ -273,8 +286,12 @@ private:
 
 std::unique_ptr<LightGlobalTerm> GridModel::forLight(const Light& light) const {
     throwIfInterrupted();
-    return withSurfaces(std::make_unique<GridLightGlobalTerm>(*this, light), settings_.surfaces,
-                        light);
+    std::unique_ptr<LightGlobalTerm> term = std::make_unique<GridLightGlobalTerm>(*this, light);
+    if (settings_.groom)
+        term = alongFibers(std::move(term), *settings_.groom,
+                           options_.fiberSampleSpacing * static_cast<float>(voxelSize()));
+    // Surfaces outermost: their shadow is exact per point, not interpolated.
+    return withSurfaces(std::move(term), settings_.surfaces, light);
 }
 
 } // namespace

@@ -116,6 +116,9 @@ struct Scene {
     std::optional<Head> head;
     std::vector<MeshSource> meshes; ///< at most kMaxMeshes
     std::optional<float> voxelSize; ///< fiber grid voxel size; nullopt: derived from the groom
+    /// Voxels between the global term's samples along a fiber (grid and
+    /// approx modes, GridOptions::fiberSampleSpacing); nullopt: the default.
+    std::optional<float> fiberSampleSpacing;
     Integrator integrator = Integrator::DualScattering;
     PathTraceSettings pathTrace; ///< the path integrator's spp, time limit, depth and seed
     GlobalTermMode globalTermMode = GlobalTermMode::Grid;

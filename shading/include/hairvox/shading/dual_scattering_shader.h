@@ -38,6 +38,11 @@
 //  - σ̄_b² in the tables is computed with the tables' d_b; the shader recomputes
 //    it for its own d_b when they differ (DualScatteringTables::withBackwardDensity).
 //
+// Evaluation: shade(ShadeBatch&) shades many points at once across SIMD lanes
+// (shading/src/shade_kernel.h: the one implementation of these formulas,
+// dispatched at run time to AVX-512, AVX2+FMA, SSE4 or the baseline); the
+// single-point functions are batches of one.
+//
 // Lifetime: the shader holds copies (the Marschner table is shared, the
 // dual-scattering tables are ~30 KB), so its arguments may be destroyed after
 // construction. shade() is const and thread-safe.
@@ -50,7 +55,43 @@
 #include <hairvox/shading/global_term.h>
 #include <hairvox/shading/marschner.h>
 
+#include <cstddef>
+#include <vector>
+
 namespace hairvox {
+
+/// Points to shade, stored as structure of arrays (the SIMD kernel's
+/// layout): reset() to the number of points, setView() each point, then per
+/// light setIncident() (each point, or all at once for a directional light)
+/// and setGlobalTerm() each point, and DualScatteringShader::shade(batch),
+/// which adds that light's E·ShadeResult to each point's radiance(). Reuse
+/// one batch to avoid reallocating.
+class ShadeBatch {
+public:
+    /// Starts a batch of `count` points with zero radiance.
+    void reset(std::size_t count);
+    std::size_t size() const { return count_; }
+    /// ω_o toward the camera and u the unit tangent at point i.
+    void setView(std::size_t i, const Vec3f& wo, const Vec3f& u);
+    /// The current light at point i: ω_i toward it (unit) and its irradiance
+    /// E (facing the light); or the same at every point.
+    void setIncident(std::size_t i, const Vec3f& wi, const Rgb& E);
+    void setIncident(const Vec3f& wi, const Rgb& E);
+    /// The current light's global term at point i.
+    void setGlobalTerm(std::size_t i, const GlobalTerm& g);
+    /// Σ over the lights shaded so far of E·ShadeResult at point i.
+    ShadeResult radiance(std::size_t i) const;
+
+private:
+    friend class DualScatteringShader;
+    /// Rows: ω_i, ω_o, u (9); then V, T_s, σ_f² (7); then E (3).
+    static constexpr std::size_t kInputRows = 19;
+    static constexpr std::size_t kOutputRows = 15; ///< ShadeResult's channels
+    float& in(std::size_t row, std::size_t i) { return inputs_[row * capacity_ + i]; }
+
+    std::size_t count_ = 0, capacity_ = 0;
+    std::vector<float> inputs_, radiance_;
+};
 
 class DualScatteringShader {
 public:
@@ -59,10 +100,11 @@ public:
     DualScatteringShader(const MarschnerBcsdf& bcsdf, const DualScatteringTables& tables,
                          const DualScatteringParams& params);
 
+    /// Adds the current light's E·ShadeResult to every point of the batch.
+    void shade(ShadeBatch& batch) const;
+
     /// ω_i toward the light, ω_o toward the camera, u the unit tangent; all unit.
-    ShadeResult shade(const Vec3f& wi, const Vec3f& wo, const Vec3f& u, const GlobalTerm& g) const {
-        return shade(FiberAngles::fromDirections(wi, wo, u), g);
-    }
+    ShadeResult shade(const Vec3f& wi, const Vec3f& wo, const Vec3f& u, const GlobalTerm& g) const;
     ShadeResult shade(const FiberAngles& a, const GlobalTerm& g) const;
 
     /// f_back with the extra longitudinal variance σ² (0: f_back^direct; σ_f²: f_back^scatter).
@@ -75,13 +117,6 @@ public:
     const DualScatteringParams& params() const { return params_; }
 
 private:
-    /// The table entries f_back needs, at θ_i.
-    struct Backscatter {
-        Rgb ABar_b, DeltaBar_b, sigma2Bar_b;
-    };
-    Backscatter backscatter(float theta_i) const;
-    Rgb fBack(const FiberAngles& a, const Backscatter& b, const Rgb& sigma2) const;
-
     MarschnerBcsdf bcsdf_;
     DualScatteringTables tables_;
     DualScatteringParams params_;

@@ -54,6 +54,13 @@
 
 namespace hairvox {
 
+class DualScatteringTables;
+namespace detail {
+struct DualScatteringTablesView;
+/// What the SIMD kernel reads of the tables (shading/src/shade_kernel.h).
+DualScatteringTablesView tablesView(const DualScatteringTables& tables);
+} // namespace detail
+
 struct TableBuildOptions {
     int thetaSamples = 181;  ///< uniform θ grid over [−π/2, π/2] (1° steps), [3, 10001]
     int quadratureOrder = 24; ///< Gauss–Legendre nodes per integration piece, [4, 256]
@@ -171,6 +178,7 @@ private:
     bool loadedFromCache_ = false;
 
     friend struct TableIo;
+    friend detail::DualScatteringTablesView detail::tablesView(const DualScatteringTables& tables);
 };
 
 std::ostream& operator<<(std::ostream& os, const DualScatteringTables::Sample& s);

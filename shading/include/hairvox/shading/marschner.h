@@ -51,6 +51,13 @@
 
 namespace hairvox {
 
+class MarschnerBcsdf;
+namespace detail {
+struct MarschnerView;
+/// What the SIMD kernel reads of a bcsdf (shading/src/shade_kernel.h).
+MarschnerView marschnerView(const MarschnerBcsdf& bcsdf);
+} // namespace detail
+
 /// Marschner's scattering paths, indexed by the number p of internal segments.
 enum class Lobe : int { R = 0, TT = 1, TRT = 2 };
 inline constexpr std::array<Lobe, 3> kLobes{Lobe::R, Lobe::TT, Lobe::TRT};
@@ -150,10 +157,11 @@ public:
 
 private:
     struct AzimuthalTable;
+    friend detail::MarschnerView detail::marschnerView(const MarschnerBcsdf& bcsdf);
 
     struct SamplingTables;
 
-    /// n_p·M_p(θ_h)/cos²θ_d per lobe.
+    /// n_p·M_p(θ_h)/cos²θ_d per lobe (evalExact's; eval's is the kernel's).
     LobeValues withLongitudinal(LobeValues n, const FiberAngles& a) const;
     /// Lobe selection probabilities at θ_o.
     std::array<float, 3> lobeWeights(float theta_o) const;

@@ -14,15 +14,19 @@
 #include <hairvox/geometry/surface_scene.h>
 #include <hairvox/shading/fiber_params.h>
 #include <hairvox/shading/global_term.h>
+#include <hairvox/strands/groom.h>
 #include <hairvox/transmittance/crossing_table.h>
 #include <hairvox/transmittance/global_term_mode.h>
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <span>
 
 namespace hairvox {
+
+inline constexpr std::uint32_t kUnknownSegment = std::numeric_limits<std::uint32_t>::max();
 
 /// A point on a fiber and that fiber's unit tangent (root → tip). The strand
 /// index, when the caller knows it, saves the exact mode a search for the
@@ -38,18 +42,26 @@ struct GlobalTermQuery {
     /// The query's fiber type (Groom::fiberType): approx mode assumes the
     /// fibers in front are of this type.
     std::uint8_t fiberType = 0;
+    /// The segment the point lies on, by its root-side point (Groom::points),
+    /// when known: lets a model sample the global term along the fiber
+    /// (alongFibers()).
+    std::uint32_t segment = kUnknownSegment;
 };
 
 /// What a per-light evaluation skipped (DESIGN.md §7).
 struct GlobalTermStats {
     std::uint64_t queries = 0;
     std::uint64_t blockedBySurface = 0; ///< shadowed by an opaque surface: no march, no rays
-    std::uint64_t emptyPaths = 0;        ///< nothing in front: n = 0 without marching
+    std::uint64_t emptyPaths = 0;        ///< of the points evaluated, nothing in front: n = 0
+    /// Points the mode evaluated: the queries not blocked by a surface, or
+    /// fewer — the samples along the fibers they were interpolated from (alongFibers()).
+    std::uint64_t evaluated = 0;
 
     GlobalTermStats& operator+=(const GlobalTermStats& o) {
         queries += o.queries;
         blockedBySurface += o.blockedBySurface;
         emptyPaths += o.emptyPaths;
+        evaluated += o.evaluated;
         return *this;
     }
 };
@@ -77,6 +89,10 @@ struct GlobalTermSettings {
     DualScatteringParams dualScattering;
     /// The opaque surfaces (head, meshes): they block light entirely. Null: none.
     std::shared_ptr<const SurfaceScene> surfaces;
+    /// The strands the queries lie on, for the grid modes' sampling along
+    /// the fibers (GridOptions::fiberSampleSpacing). Null: every query is
+    /// evaluated. Must outlive the model.
+    const Groom* groom = nullptr;
 
     void validate() const;
 };
@@ -96,6 +112,19 @@ public:
 ///   sumBeta2    expected Σβ̄_f² over crossings          → σ_f² = sumBeta2 / (1 − V)
 /// T_s = d_f·(P − V) ≥ 0, continuous as n → 0.
 GlobalTerm globalTermFromDepths(float n, const Rgb& tauP, const Rgb& sumBeta2, float d_f);
+
+/// Wraps a per-light evaluation so that a point on a fiber segment
+/// (GlobalTermQuery::segment) gets the global term interpolated linearly
+/// between samples along that segment, at t = k/m with m = ⌈length/spacing⌉
+/// (world units): the global term varies on the scale of the grid's voxels,
+/// a fragment every pixel. A batch evaluates each sample its queries need
+/// once per run of consecutive queries on one segment (callers that order
+/// their points by segment share the most). A sample's position depends only
+/// on its segment, so batches, tiles and thread counts agree; queries without
+/// a segment, or not on a fiber, are evaluated as they are. The samples take
+/// the segment's direction as their tangent (what approx mode reads).
+std::unique_ptr<LightGlobalTerm> alongFibers(std::unique_ptr<LightGlobalTerm> inner,
+                                             const Groom& groom, float spacing);
 
 /// Wraps a per-light evaluation so that points whose path to the light meets
 /// an opaque surface get GlobalTerm::blocked() without being evaluated: one

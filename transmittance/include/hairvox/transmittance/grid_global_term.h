@@ -104,6 +104,10 @@ struct GridOptions {
     GridEvaluation evaluation = GridEvaluation::Cache;
     float startOffset = 0.5f;  ///< voxels toward the light before integrating, [0, 8]
     float cacheSpacing = 1.5f; ///< voxels between the cache's shadow lines, [0.5, 4]
+    /// Voxels between the samples along a fiber that a query on it is
+    /// interpolated from (alongFibers(); needs GlobalTermSettings::groom),
+    /// 0: every query evaluated. [0, 4]
+    float fiberSampleSpacing = 1.0f;
 
     void validate(const FiberGrid& grid) const;
 };

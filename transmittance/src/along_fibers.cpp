@@ -1,0 +1,123 @@
+// The global term sampled along the fibers and interpolated (alongFibers(),
+// global_term_model.h).
+#include <hairvox/transmittance/global_term_model.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace hairvox {
+
+namespace {
+
+GlobalTerm lerp(float f, const GlobalTerm& a, const GlobalTerm& b) {
+    const auto mix = [f](const auto& x, const auto& y) { return x + f * (y - x); };
+    GlobalTerm g;
+    g.n = mix(a.n, b.n);
+    g.V = mix(a.V, b.V);
+    g.P = mix(a.P, b.P);
+    g.T_s = mix(a.T_s, b.T_s);
+    g.sigma2_f = mix(a.sigma2_f, b.sigma2_f);
+    return g;
+}
+
+class AlongFibers final : public LightGlobalTerm {
+public:
+    AlongFibers(std::unique_ptr<LightGlobalTerm> inner, const Groom& groom, float spacing)
+        : inner_(std::move(inner))
+        , points_(groom.points)
+        , spacing_(spacing) {}
+
+    std::size_t memoryBytes() const override { return inner_->memoryBytes(); }
+    bool blocksEverything() const override { return inner_->blocksEverything(); }
+
+    GlobalTermStats evaluate(std::span<const GlobalTermQuery> queries,
+                             std::span<GlobalTerm> out) const override {
+        // Per query: the sample at or below it (an index into `samples`) and
+        // the fraction toward the next one, which is the sample after it.
+        struct Where {
+            std::uint32_t sample;
+            float f;
+        };
+        std::vector<GlobalTermQuery> samples;
+        std::vector<Where> where(queries.size());
+        std::vector<int> needed; // sample numbers k along the current segment
+        samples.reserve(queries.size());
+        const auto evaluateAsIs = [&](std::size_t i) {
+            where[i] = {static_cast<std::uint32_t>(samples.size()), 0.0f};
+            samples.push_back(queries[i]);
+        };
+        std::size_t i = 0;
+        while (i < queries.size()) {
+            const GlobalTermQuery& q = queries[i];
+            if (q.segment == kUnknownSegment || !q.onFiber ||
+                std::size_t(q.segment) + 1 >= points_.size()) {
+                evaluateAsIs(i++);
+                continue;
+            }
+            // The run of queries on this segment, each at t = x/m, x ∈ [k, k + 1].
+            const Vec3f p0 = points_[q.segment], d = points_[q.segment + 1] - p0;
+            const float length2 = glm::dot(d, d);
+            const int m = std::max(1, static_cast<int>(std::ceil(std::sqrt(length2) / spacing_)));
+            std::size_t end = i;
+            needed.clear();
+            for (; end < queries.size() && queries[end].segment == q.segment && queries[end].onFiber;
+                 ++end) {
+                const float t =
+                    length2 > 0
+                        ? std::clamp(glm::dot(queries[end].position - p0, d) / length2, 0.0f, 1.0f)
+                        : 0.0f;
+                const float x = t * float(m);
+                const int k = std::min(static_cast<int>(x), m - 1);
+                where[end] = {static_cast<std::uint32_t>(k), x - float(k)};
+                needed.push_back(k);
+                needed.push_back(k + 1);
+            }
+            std::sort(needed.begin(), needed.end());
+            needed.erase(std::unique(needed.begin(), needed.end()), needed.end());
+            if (needed.size() >= end - i) {
+                // Sparse along the segment (a far, long one): sampling saves nothing.
+                for (std::size_t j = i; j < end; ++j)
+                    evaluateAsIs(j);
+                i = end;
+                continue;
+            }
+            const auto base = static_cast<std::uint32_t>(samples.size());
+            const Vec3f tangent = normalizeOr(d, q.tangent);
+            for (int k : needed)
+                samples.push_back({p0 + (float(k) / float(m)) * d, tangent, q.strand, true,
+                                   q.fiberType, kUnknownSegment});
+            for (std::size_t j = i; j < end; ++j) {
+                const int k = static_cast<int>(where[j].sample);
+                where[j].sample =
+                    base + static_cast<std::uint32_t>(
+                               std::lower_bound(needed.begin(), needed.end(), k) - needed.begin());
+            }
+            i = end;
+        }
+        std::vector<GlobalTerm> values(samples.size());
+        GlobalTermStats stats = inner_->evaluate(samples, values);
+        for (std::size_t j = 0; j < queries.size(); ++j) {
+            const Where w = where[j];
+            out[j] = w.f > 0 ? lerp(w.f, values[w.sample], values[w.sample + 1]) : values[w.sample];
+        }
+        stats.queries = queries.size();
+        return stats;
+    }
+
+private:
+    std::unique_ptr<LightGlobalTerm> inner_;
+    const std::vector<Vec3f>& points_;
+    float spacing_;
+};
+
+} // namespace
+
+std::unique_ptr<LightGlobalTerm> alongFibers(std::unique_ptr<LightGlobalTerm> inner,
+                                             const Groom& groom, float spacing) {
+    if (!(spacing > 0))
+        return inner;
+    return std::make_unique<AlongFibers>(std::move(inner), groom, spacing);
+}
+
+} // namespace hairvox
