@@ -4,6 +4,8 @@
 #include <hairvox/core/parallel.h>
 #include <hairvox/film/image_file.h>
 
+#include "half_convert.h"
+
 #include <tbb/parallel_for.h>
 
 #include <ImfChannelList.h>
@@ -17,7 +19,9 @@
 #include <ImfThreading.h>
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <exception>
+#include <memory>
 #include <half.h>
 
 namespace hairvox {
@@ -35,8 +39,8 @@ constexpr int kBandRows = 256;
 struct ExrChannel {
     std::string name;
     const float* first; ///< pixel (0, 0)
-    std::size_t stride; ///< bytes between pixels
-    bool half;
+    std::size_t stride; ///< floats between pixels (1 or 3)
+    bool half = true;
 };
 
 class ExrLayout {
@@ -45,15 +49,24 @@ public:
         : width_(std::size_t(film.width()))
         , pixels_(film.pixelCount()) {
         static constexpr const char* rgb[3] = {"R", "G", "B"};
+        std::vector<bool> fullPrecision;
         for (const FilmLayer& l : film.layers()) {
             if (l.channels == 1) {
-                add(l.name, l.data.data(), sizeof(float), l.fullPrecision);
+                channels_.push_back({l.name, l.data.data(), 1});
+                fullPrecision.push_back(l.fullPrecision);
                 continue;
             }
-            for (int c = 0; c < 3; ++c)
-                add(l.name.empty() ? rgb[c] : l.name + "." + rgb[c], l.data.data() + c,
-                    3 * sizeof(float), l.fullPrecision);
+            for (int c = 0; c < 3; ++c) {
+                channels_.push_back(
+                    {l.name.empty() ? rgb[c] : l.name + "." + rgb[c], l.data.data() + c, 3});
+                fullPrecision.push_back(l.fullPrecision);
+            }
         }
+        // Half unless the layer asks for float or a value does not fit.
+        tbb::parallel_for(std::size_t(0), channels_.size(), [&](std::size_t i) {
+            ExrChannel& c = channels_[i];
+            c.half = !fullPrecision[i] && detail::maxAbs(c.first, c.stride, pixels_) <= kHalfMax;
+        });
     }
 
     void declare(Imf::Header& header) const {
@@ -63,30 +76,31 @@ public:
 
     /// Converts rows [y0, y0 + rows) into the band buffers and points `file` at them.
     void setBand(Imf::OutputFile& file, int y0, int rows) {
-        Imf::FrameBuffer frameBuffer;
+        const std::size_t capacity = width_ * std::size_t(kBandRows);
+        if (!band_) // written before read: no need to zero it
+            band_ = std::make_unique_for_overwrite<std::uint32_t[]>(channels_.size() * capacity);
         const std::size_t count = width_ * std::size_t(rows);
-        halves_.resize(channels_.size() * count);
-        floats_.resize(channels_.size() * count);
-        // The conversion runs on the calling threads while OpenEXR's pool
-        // waits for the band: one channel per task.
-        tbb::parallel_for(std::size_t(0), channels_.size(), [&](std::size_t i) {
-            const ExrChannel& c = channels_[i];
-            const auto* src =
-                reinterpret_cast<const char*>(c.first) + std::size_t(y0) * width_ * c.stride;
-            if (c.half) {
-                half* dst = halves_.data() + i * count;
-                for (std::size_t p = 0; p < count; ++p)
-                    dst[p] = half(*reinterpret_cast<const float*>(src + p * c.stride));
-            } else {
-                float* dst = floats_.data() + i * count;
-                for (std::size_t p = 0; p < count; ++p)
-                    dst[p] = *reinterpret_cast<const float*>(src + p * c.stride);
-            }
+        // Channels × blocks of rows, converted on the calling threads while
+        // OpenEXR's pool waits for the band.
+        constexpr std::size_t kRowsPerTask = 64;
+        const std::size_t blocks = (std::size_t(rows) + kRowsPerTask - 1) / kRowsPerTask;
+        tbb::parallel_for(std::size_t(0), channels_.size() * blocks, [&](std::size_t task) {
+            const ExrChannel& c = channels_[task / blocks];
+            const std::size_t begin = (task % blocks) * kRowsPerTask * width_;
+            const std::size_t n = std::min(count, begin + kRowsPerTask * width_) - begin;
+            const float* src = c.first + (std::size_t(y0) * width_ + begin) * c.stride;
+            std::uint32_t* dst = band_.get() + (task / blocks) * capacity;
+            if (c.half)
+                detail::toHalf(src, c.stride, n, reinterpret_cast<std::uint16_t*>(dst) + begin);
+            else
+                for (std::size_t p = 0; p < n; ++p)
+                    std::memcpy(dst + begin + p, src + p * c.stride, sizeof(float));
         });
+        Imf::FrameBuffer frameBuffer;
         for (std::size_t i = 0; i < channels_.size(); ++i) {
             const ExrChannel& c = channels_[i];
-            void* band = c.half ? static_cast<void*>(halves_.data() + i * count)
-                                : static_cast<void*>(floats_.data() + i * count);
+            char* band = reinterpret_cast<char*>(band_.get() + i * capacity);
+            // The band's first value is pixel (0, y0).
             frameBuffer.insert(c.name,
                                Imf::Slice::Make(c.half ? Imf::HALF : Imf::FLOAT, band,
                                                 Imath::V2i(0, y0), std::int64_t(width_), rows));
@@ -95,18 +109,10 @@ public:
     }
 
 private:
-    void add(const std::string& name, const float* first, std::size_t stride, bool alwaysFloat) {
-        bool fitsHalf = !alwaysFloat;
-        const auto* bytes = reinterpret_cast<const char*>(first);
-        for (std::size_t i = 0; i < pixels_ && fitsHalf; ++i)
-            fitsHalf = std::abs(*reinterpret_cast<const float*>(bytes + i * stride)) <= kHalfMax;
-        channels_.push_back({name, first, stride, fitsHalf});
-    }
-
     std::size_t width_, pixels_;
     std::vector<ExrChannel> channels_;
-    std::vector<half> halves_;
-    std::vector<float> floats_;
+    /// One band: per channel kBandRows rows of halves or floats (4 bytes reserved per value).
+    std::unique_ptr<std::uint32_t[]> band_;
 };
 
 } // namespace

@@ -41,7 +41,6 @@ public:
         };
         std::vector<GlobalTermQuery> samples;
         std::vector<Where> where(queries.size());
-        std::vector<int> needed; // sample numbers k along the current segment
         samples.reserve(queries.size());
         const auto evaluateAsIs = [&](std::size_t i) {
             where[i] = {static_cast<std::uint32_t>(samples.size()), 0.0f};
@@ -59,24 +58,20 @@ public:
             const Vec3f p0 = points_[q.segment], d = points_[q.segment + 1] - p0;
             const float length2 = glm::dot(d, d);
             const int m = std::max(1, static_cast<int>(std::ceil(std::sqrt(length2) / spacing_)));
+            const float scale = length2 > 0 ? float(m) / length2 : 0.0f;
             std::size_t end = i;
-            needed.clear();
+            int kMin = m, kMax = 0;
             for (; end < queries.size() && queries[end].segment == q.segment && queries[end].onFiber;
                  ++end) {
-                const float t =
-                    length2 > 0
-                        ? std::clamp(glm::dot(queries[end].position - p0, d) / length2, 0.0f, 1.0f)
-                        : 0.0f;
-                const float x = t * float(m);
+                const float x = std::clamp(glm::dot(queries[end].position - p0, d) * scale, 0.0f, float(m));
                 const int k = std::min(static_cast<int>(x), m - 1);
                 where[end] = {static_cast<std::uint32_t>(k), x - float(k)};
-                needed.push_back(k);
-                needed.push_back(k + 1);
+                kMin = std::min(kMin, k);
+                kMax = std::max(kMax, k);
             }
-            std::sort(needed.begin(), needed.end());
-            needed.erase(std::unique(needed.begin(), needed.end()), needed.end());
-            if (needed.size() >= end - i) {
-                // Sparse along the segment (a far, long one): sampling saves nothing.
+            if (std::size_t(kMax - kMin + 2) >= end - i) {
+                // The queries lie sparse along the segment (a long one, seen
+                // from afar): sampling it would evaluate more, not less.
                 for (std::size_t j = i; j < end; ++j)
                     evaluateAsIs(j);
                 i = end;
@@ -84,15 +79,11 @@ public:
             }
             const auto base = static_cast<std::uint32_t>(samples.size());
             const Vec3f tangent = normalizeOr(d, q.tangent);
-            for (int k : needed)
+            for (int k = kMin; k <= kMax + 1; ++k)
                 samples.push_back({p0 + (float(k) / float(m)) * d, tangent, q.strand, true,
                                    q.fiberType, kUnknownSegment});
-            for (std::size_t j = i; j < end; ++j) {
-                const int k = static_cast<int>(where[j].sample);
-                where[j].sample =
-                    base + static_cast<std::uint32_t>(
-                               std::lower_bound(needed.begin(), needed.end(), k) - needed.begin());
-            }
+            for (std::size_t j = i; j < end; ++j)
+                where[j].sample += base - static_cast<std::uint32_t>(kMin);
             i = end;
         }
         std::vector<GlobalTerm> values(samples.size());

@@ -76,7 +76,7 @@ struct ExrHeader {
     /// EXR alone): level 1 0.61–0.73 s for 18.7 MB, level 4 (OpenEXR's
     /// default) 0.78–1.10 s for 18.0 MB.
     int zipLevel = kDefaultExrZipLevel;
-    ExrCompression compression = ExrCompression::Zips;
+    ExrCompression compression = ExrCompression::Rle;
 };
 
 /// Writes every layer of the film as one multi-layer EXR, atomically.

@@ -102,7 +102,7 @@ struct OutputSettings {
     float exposure = 0;                ///< stops applied to the PNG preview only, [-20, 20]
     ToneMap toneMap = ToneMap::Filmic; ///< of the PNG preview (film/image_file.h)
     int exrZipLevel = kDefaultExrZipLevel; ///< zlib level of the EXR, [1, 9] (ExrHeader)
-    ExrCompression exrCompression = ExrCompression::Zips; ///< of the EXR (ExrCompression)
+    ExrCompression exrCompression = ExrCompression::Rle; ///< of the EXR (ExrCompression)
 };
 
 struct Scene {
