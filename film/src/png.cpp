@@ -3,6 +3,8 @@
 #include <hairvox/film/image_file.h>
 
 #include <png.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -30,15 +32,19 @@ std::vector<std::uint8_t> previewPixels(const Film& film, float exposure, ToneMa
     const float scale = std::exp2(exposure);
     std::vector<std::uint8_t> out(film.pixelCount() * 3);
     const FilmLayer& beauty = film.layer(Film::kBeauty);
-    for (std::size_t p = 0; p < film.pixelCount(); ++p) {
-        const Rgb c = beauty.rgb(p);
-        for (int ch = 0; ch < 3; ++ch) {
-            const float x = std::max(c[ch] * scale, 0.0f);
-            const float mapped = toneMap == ToneMap::Filmic ? filmic(x) : std::min(x, 1.0f);
-            out[p * 3 + std::size_t(ch)] =
-                static_cast<std::uint8_t>(std::lround(255.0f * srgbEncode(mapped)));
-        }
-    }
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, film.pixelCount(), 16384),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                          for (std::size_t p = range.begin(); p != range.end(); ++p) {
+                              const Rgb c = beauty.rgb(p);
+                              for (int ch = 0; ch < 3; ++ch) {
+                                  const float x = std::max(c[ch] * scale, 0.0f);
+                                  const float mapped =
+                                      toneMap == ToneMap::Filmic ? filmic(x) : std::min(x, 1.0f);
+                                  out[p * 3 + std::size_t(ch)] = static_cast<std::uint8_t>(
+                                      std::lround(255.0f * srgbEncode(mapped)));
+                              }
+                          }
+                      });
     return out;
 }
 
@@ -51,14 +57,13 @@ std::vector<std::uint8_t> encodePng(int width, int height, const std::vector<std
     image.width = static_cast<png_uint_32>(width);
     image.height = static_cast<png_uint_32>(height);
     image.format = PNG_FORMAT_RGB;
-    png_alloc_size_t size = 0; // first the size, then the bytes
-    std::vector<std::uint8_t> png;
-    if (png_image_write_to_memory(&image, nullptr, &size, 0, rgb.data(), 0, nullptr)) {
+    // One pass into a buffer of the largest size a PNG of this image can
+    // have (asking libpng for the size first would encode it twice).
+    png_alloc_size_t size = PNG_IMAGE_PNG_SIZE_MAX(image);
+    std::vector<std::uint8_t> png(size);
+    if (png_image_write_to_memory(&image, png.data(), &size, 0, rgb.data(), 0, nullptr)) {
         png.resize(size);
-        if (png_image_write_to_memory(&image, png.data(), &size, 0, rgb.data(), 0, nullptr)) {
-            png.resize(size);
-            return png;
-        }
+        return png;
     }
     const std::string message = image.message;
     png_image_free(&image);

@@ -72,7 +72,7 @@ TEST(Scene, EveryFeatureParses) {
     j["lights"][0]["name"] = "key";
     j["lights"][0]["color"] = {1, 0.9, 0.8};
     j["head"] = {{"center", {0, 0, -0.5}}, {"radius", 0.1}, {"color", {0.5, 0.4, 0.3}}};
-    j["grid"] = {{"voxel_size", 0.002}};
+    j["grid"] = {{"voxel_size", 0.002}, {"fiber_sample_spacing", 0.5}};
     j["global_term"] = {{"mode", "exact"},
                         {"exact", {{"rays", 8}, {"radius", 0.001}, {"seed", 5}}}};
     j["shading_rate"] = "vertex";
@@ -95,6 +95,7 @@ TEST(Scene, EveryFeatureParses) {
     ASSERT_TRUE(s.head.has_value());
     EXPECT_FLOAT_EQ(s.head->sphere.center.z, -0.5f);
     EXPECT_FLOAT_EQ(*s.voxelSize, 0.002f);
+    EXPECT_FLOAT_EQ(*s.fiberSampleSpacing, 0.5f);
     EXPECT_EQ(s.globalTermMode, GlobalTermMode::Exact);
     EXPECT_EQ(s.exact.rays, 8u);
     EXPECT_EQ(s.exact.seed, 5u);
@@ -165,6 +166,10 @@ TEST(Scene, WrongTypesNameTheirPathAndTheExpectedType) {
     j["grid"] = {{"voxel_size", "big"}};
     EXPECT_EQ(errorOf(j), "scene.json: /grid/voxel_size: expected \"auto\" or a number in (0, "
                           "1000], got \"big\"");
+    j = validScene();
+    j["grid"] = {{"fiber_sample_spacing", 5}};
+    EXPECT_EQ(errorOf(j), "scene.json: /grid/fiber_sample_spacing: expected a number in [0, 4], "
+                          "got 5");
 }
 
 TEST(Scene, OutOfRangeValuesNameTheirPathAndRange) {

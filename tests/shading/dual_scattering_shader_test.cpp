@@ -208,6 +208,56 @@ TEST(DualScatteringShader, RejectsMismatchedTablesAndBadParams) {
     EXPECT_THROW(DualScatteringShader(bcsdf, DualScatteringTables::build(FiberParams{}), bad), InputError);
 }
 
+TEST(DualScatteringShader, ABatchShadesEachPointAsAloneAndSumsTheLights) {
+    // The renderer's path: many points (not a whole number of SIMD vectors),
+    // two lights with their irradiance, some points unlit by one of them.
+    // Each light's share must be the single-point shade (the same lanes),
+    // scaled by its irradiance, and an unlit point gets nothing from it.
+    const Fixture f;
+    Pcg32 rng(12);
+    constexpr std::size_t count = 1001;
+    struct Point {
+        Vec3f wo, u, wi[2];
+        GlobalTerm g[2];
+    };
+    std::vector<Point> points(count);
+    const Rgb E[2] = {Rgb(1.0f, 0.9f, 0.8f), Rgb(3.0f, 3.5f, 4.0f)};
+    ShadeBatch batch;
+    batch.reset(count);
+    for (std::size_t i = 0; i < count; ++i) {
+        Point& p = points[i];
+        p.u = test::fiberDirection(Vec3f(0, 1, 0), rng.uniform(-1.5f, 1.5f), rng.uniform(-3, 3));
+        p.wo = test::fiberDirection(p.u, rng.uniform(-1.5f, 1.5f), rng.uniform(-3, 3));
+        for (int l = 0; l < 2; ++l) {
+            p.wi[l] = test::fiberDirection(p.u, rng.uniform(-1.5f, 1.5f), rng.uniform(-3, 3));
+            const FiberAngles a = FiberAngles::fromDirections(p.wi[l], p.wo, p.u);
+            p.g[l] = i % 7 == 0 ? GlobalTerm::blocked()
+                                : poissonTerm(f.tables, a.theta_i, rng.uniform(0.0f, 4.0f), 1.0f);
+        }
+        batch.setView(i, p.wo, p.u);
+    }
+    for (int l = 0; l < 2; ++l) {
+        for (std::size_t i = 0; i < count; ++i) {
+            batch.setIncident(i, points[i].wi[l], E[l]);
+            batch.setGlobalTerm(i, points[i].g[l]);
+        }
+        f.shader.shade(batch);
+    }
+    for (std::size_t i = 0; i < count; ++i) {
+        const Point& p = points[i];
+        const ShadeResult r = batch.radiance(i);
+        Rgb expected(0.0f);
+        for (int l = 0; l < 2; ++l)
+            expected += E[l] * f.shader.shade(p.wi[l], p.wo, p.u, p.g[l]).total();
+        const Rgb total = r.total();
+        for (int c = 0; c < 3; ++c)
+            ASSERT_NEAR(total[c], expected[c], 1e-5f * expected[c] + 1e-12f) << "point " << i;
+        if (i % 7 == 0) {
+            ASSERT_EQ(total, Rgb(0.0f)) << "point " << i;
+        }
+    }
+}
+
 TEST(DualScatteringShader, OutlivesItsArguments) {
     std::optional<DualScatteringShader> shader;
     {

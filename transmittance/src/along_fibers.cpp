@@ -41,17 +41,15 @@ public:
         };
         std::vector<GlobalTermQuery> samples;
         std::vector<Where> where(queries.size());
+        std::vector<int> needed; // sample numbers along the current segment
         samples.reserve(queries.size());
-        const auto evaluateAsIs = [&](std::size_t i) {
-            where[i] = {static_cast<std::uint32_t>(samples.size()), 0.0f};
-            samples.push_back(queries[i]);
-        };
         std::size_t i = 0;
         while (i < queries.size()) {
             const GlobalTermQuery& q = queries[i];
             if (q.segment == kUnknownSegment || !q.onFiber ||
                 std::size_t(q.segment) + 1 >= points_.size()) {
-                evaluateAsIs(i++);
+                where[i++] = {static_cast<std::uint32_t>(samples.size()), 0.0f};
+                samples.push_back(q);
                 continue;
             }
             // The run of queries on this segment, each at t = x/m, x ∈ [k, k + 1].
@@ -63,27 +61,43 @@ public:
             int kMin = m, kMax = 0;
             for (; end < queries.size() && queries[end].segment == q.segment && queries[end].onFiber;
                  ++end) {
-                const float x = std::clamp(glm::dot(queries[end].position - p0, d) * scale, 0.0f, float(m));
+                const float x =
+                    std::clamp(glm::dot(queries[end].position - p0, d) * scale, 0.0f, float(m));
                 const int k = std::min(static_cast<int>(x), m - 1);
                 where[end] = {static_cast<std::uint32_t>(k), x - float(k)};
                 kMin = std::min(kMin, k);
                 kMax = std::max(kMax, k);
             }
-            if (std::size_t(kMax - kMin + 2) >= end - i) {
-                // The queries lie sparse along the segment (a long one, seen
-                // from afar): sampling it would evaluate more, not less.
-                for (std::size_t j = i; j < end; ++j)
-                    evaluateAsIs(j);
-                i = end;
-                continue;
+            // The samples k, k + 1 the run needs: all of kMin ... kMax + 1
+            // when the queries lie dense along the segment (the common case:
+            // several fragments per sample), else just those (a long segment
+            // seen from afar: at most two per query). Either way a query's
+            // value depends only on its own position, not on the batch.
+            needed.clear();
+            const bool dense = std::size_t(kMax - kMin + 2) <= 2 * (end - i);
+            if (dense) {
+                for (int k = kMin; k <= kMax + 1; ++k)
+                    needed.push_back(k);
+            } else {
+                for (std::size_t j = i; j < end; ++j) {
+                    needed.push_back(static_cast<int>(where[j].sample));
+                    needed.push_back(static_cast<int>(where[j].sample) + 1);
+                }
+                std::sort(needed.begin(), needed.end());
+                needed.erase(std::unique(needed.begin(), needed.end()), needed.end());
             }
             const auto base = static_cast<std::uint32_t>(samples.size());
             const Vec3f tangent = normalizeOr(d, q.tangent);
-            for (int k = kMin; k <= kMax + 1; ++k)
+            for (int k : needed)
                 samples.push_back({p0 + (float(k) / float(m)) * d, tangent, q.strand, true,
                                    q.fiberType, kUnknownSegment});
-            for (std::size_t j = i; j < end; ++j)
-                where[j].sample += base - static_cast<std::uint32_t>(kMin);
+            for (std::size_t j = i; j < end; ++j) {
+                const int k = static_cast<int>(where[j].sample);
+                const auto offset =
+                    dense ? k - kMin
+                          : std::lower_bound(needed.begin(), needed.end(), k) - needed.begin();
+                where[j].sample = base + static_cast<std::uint32_t>(offset);
+            }
             i = end;
         }
         std::vector<GlobalTerm> values(samples.size());
