@@ -165,8 +165,10 @@ TEST(ExrFile, HalvesRoundAsImathDoesOnEveryCpu) {
     // in scalar and RGB layers (3 floats apart) and in the vector tails.
     constexpr int width = 259, height = 7;
     Film film(width, height);
-    FilmLayer& rgb = film.layer(film.addLayer("direct_R", 3));
-    FilmLayer& scalar = film.layer(film.addLayer("key.V", 1));
+    const std::size_t rgbLayer = film.addLayer("direct_R", 3);
+    const std::size_t scalarLayer = film.addLayer("key.V", 1);
+    FilmLayer& rgb = film.layer(rgbLayer);
+    FilmLayer& scalar = film.layer(scalarLayer);
     Pcg32 rng(17);
     std::vector<float> special{0.0f, -0.0f, 65504.0f, -65504.0f, 6.1035156e-5f, 5.9604645e-8f,
                                2.9802322e-8f, 2.9802326e-8f, 8.940697e-8f, 1.0f + 1.0f / 2048.0f,

@@ -164,8 +164,11 @@ TEST(AlongFibers, GridSampledAVoxelApartMatchesEveryPoint) {
     every.fiberSampleSpacing = 0;
     sampled.fiberSampleSpacing = 1;
     const Light light = Light::directional(glm::normalize(Vec3f(0.3f, 1, 0.2f)));
-    const auto a = makeGridModel(grid, {test::constantTable(0.6f, 0.02f)}, settings, every)->forLight(light);
-    const auto b = makeGridModel(grid, {test::constantTable(0.6f, 0.02f)}, settings, sampled)->forLight(light);
+    const auto everyModel = makeGridModel(grid, {test::constantTable(0.6f, 0.02f)}, settings, every);
+    const auto sampledModel =
+        makeGridModel(grid, {test::constantTable(0.6f, 0.02f)}, settings, sampled);
+    const auto a = everyModel->forLight(light);
+    const auto b = sampledModel->forLight(light);
     // Runs of points along 200 fibers, as a rasterizer hands them over.
     std::vector<GlobalTermQuery> queries;
     for (std::uint32_t s = 0; s < 200; ++s) {

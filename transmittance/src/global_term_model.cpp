@@ -42,25 +42,38 @@ public:
 
     GlobalTermStats evaluate(std::span<const GlobalTermQuery> queries,
                              std::span<GlobalTerm> out) const override {
-        std::vector<GlobalTermQuery> open;
-        std::vector<std::size_t> openIndex;
-        open.reserve(queries.size());
-        openIndex.reserve(queries.size());
+        std::vector<std::uint32_t> blocked;
         for (std::size_t i = 0; i < queries.size(); ++i) {
             const Light::Path path = light_.pathFrom(queries[i].position);
-            if (surfaces_->occluded(queries[i].position, path.omega, path.distance)) {
-                out[i] = GlobalTerm::blocked();
-            } else {
-                open.push_back(queries[i]);
-                openIndex.push_back(i);
-            }
+            if (surfaces_->occluded(queries[i].position, path.omega, path.distance))
+                blocked.push_back(static_cast<std::uint32_t>(i));
         }
-        std::vector<GlobalTerm> openOut(open.size());
-        GlobalTermStats stats = inner_->evaluate(open, openOut);
-        for (std::size_t k = 0; k < open.size(); ++k)
-            out[openIndex[k]] = openOut[k];
+        GlobalTermStats stats;
+        if (blocked.empty()) {
+            // The common batch: nothing to take out, nothing to copy.
+            stats = inner_->evaluate(queries, out);
+        } else {
+            std::vector<GlobalTermQuery> open;
+            std::vector<std::size_t> openIndex;
+            open.reserve(queries.size() - blocked.size());
+            openIndex.reserve(queries.size() - blocked.size());
+            std::size_t next = 0;
+            for (std::size_t i = 0; i < queries.size(); ++i) {
+                if (next < blocked.size() && blocked[next] == i) {
+                    out[i] = GlobalTerm::blocked();
+                    ++next;
+                } else {
+                    open.push_back(queries[i]);
+                    openIndex.push_back(i);
+                }
+            }
+            std::vector<GlobalTerm> openOut(open.size());
+            stats = inner_->evaluate(open, openOut);
+            for (std::size_t k = 0; k < open.size(); ++k)
+                out[openIndex[k]] = openOut[k];
+        }
         stats.queries = queries.size();
-        stats.blockedBySurface += queries.size() - open.size();
+        stats.blockedBySurface += blocked.size();
         return stats;
     }
 
