@@ -99,7 +99,8 @@ void BM_MarschnerEvalExact(benchmark::State& state) {
     });
 }
 
-/// The full shader: direct and scattered light both present (no component
+/// The full shader at one point at a time (a batch of one: the SIMD lanes
+/// mostly idle): direct and scattered light both present (no component
 /// skipped). Argument: coherent inputs.
 void BM_ShaderShade(benchmark::State& state) {
     const DualScatteringShader& shader = shading().shader;
@@ -112,6 +113,36 @@ void BM_ShaderShade(benchmark::State& state) {
     loop(
         state, [&](const Inputs& in, std::size_t k) { return shader.shade(in.wi[k], in.wo[k], in.u[k], g); },
         state.range(0) != 0);
+}
+
+/// The renderer's path: the same shader over batches of 1024 points (the
+/// rasterizer's shading batch) across SIMD lanes; time per point.
+/// Argument: coherent inputs.
+void BM_ShaderShadeBatch(benchmark::State& state) {
+    const DualScatteringShader& shader = shading().shader;
+    const Inputs& in = inputs(state.range(0) != 0);
+    GlobalTerm g;
+    g.n = 2;
+    g.V = std::exp(-2.0f);
+    g.P = Rgb(0.5f, 0.4f, 0.3f);
+    g.T_s = 0.7f * (g.P - Rgb(g.V));
+    g.sigma2_f = Rgb(0.02f, 0.021f, 0.022f);
+    constexpr std::size_t kBatch = 1024;
+    ShadeBatch batch;
+    std::size_t first = 0;
+    for (auto _ : state) {
+        batch.reset(kBatch);
+        for (std::size_t i = 0; i < kBatch; ++i) {
+            const std::size_t k = (first + i) & (in.wi.size() - 1);
+            batch.setView(i, in.wo[k], in.u[k]);
+            batch.setIncident(i, in.wi[k], Rgb(1.0f));
+            batch.setGlobalTerm(i, g);
+        }
+        shader.shade(batch);
+        benchmark::DoNotOptimize(batch.radiance(0));
+        first += kBatch;
+    }
+    state.SetItemsProcessed(state.iterations() * std::int64_t(kBatch));
 }
 
 void BM_ShaderShadeUnshadowed(benchmark::State& state) {
@@ -151,6 +182,7 @@ BENCHMARK(BM_FiberAngles);
 BENCHMARK(BM_MarschnerEval);
 BENCHMARK(BM_MarschnerEvalExact);
 BENCHMARK(BM_ShaderShade)->Arg(0)->Arg(1)->ArgName("coherent");
+BENCHMARK(BM_ShaderShadeBatch)->Arg(0)->Arg(1)->ArgName("coherent");
 BENCHMARK(BM_ShaderShadeUnshadowed);
 BENCHMARK(BM_TableLookupForward);
 BENCHMARK(BM_MarschnerTableBuild)->ArgsProduct({{1, 2}, {0, 1}})->ArgNames({"threads", "eccentric"})->Unit(benchmark::kMillisecond);

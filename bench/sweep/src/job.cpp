@@ -248,6 +248,7 @@ json measurementToJson(const BenchMeasurement& m) {
               {"voxel_size", m.voxelSize},
               {"default_voxel_size", m.defaultVoxelSize},
               {"image", nullptr},
+              {"image_blocks", nullptr},
               {"probe", nullptr},
               {"path_trace", nullptr}};
     if (m.pathTrace) {
@@ -262,14 +263,19 @@ json measurementToJson(const BenchMeasurement& m) {
                            {"energy_at_depth_cap", s.energyAtDepthCap},
                            {"time_limited", s.timeLimited}};
     }
+    const auto imageJson = [](const ImageError& e) {
+        return json{{"rel_l1", e.relL1},
+                    {"rel_rmse", e.relRmse},
+                    {"pixels", e.pixels},
+                    {"rel_bias", e.relBias},
+                    {"noise_floor_l1", e.noiseFloorL1},
+                    {"rel_l1_noise_removed", e.relL1NoiseRemoved},
+                    {"rel_rmse_noise_removed", e.relRmseNoiseRemoved}};
+    };
     if (m.image)
-        j["image"] = {{"rel_l1", m.image->relL1},
-                      {"rel_rmse", m.image->relRmse},
-                      {"pixels", m.image->pixels},
-                      {"rel_bias", m.image->relBias},
-                      {"noise_floor_l1", m.image->noiseFloorL1},
-                      {"rel_l1_noise_removed", m.image->relL1NoiseRemoved},
-                      {"rel_rmse_noise_removed", m.image->relRmseNoiseRemoved}};
+        j["image"] = imageJson(*m.image);
+    if (m.imageBlocks)
+        j["image_blocks"] = imageJson(*m.imageBlocks);
     if (m.probe)
         j["probe"] = {{"mae_v", m.probe->maeV},
                       {"mae_ts", m.probe->maeT_s},
@@ -297,7 +303,7 @@ BenchMeasurement measurementFromJson(const json& j) {
     m.activeVoxels = j.at("active_voxels").get<std::uint64_t>();
     m.voxelSize = j.at("voxel_size").get<double>();
     m.defaultVoxelSize = j.at("default_voxel_size").get<double>();
-    if (const json& i = j.at("image"); !i.is_null()) {
+    const auto imageFromJson = [](const json& i) {
         ImageError e;
         e.relL1 = i.at("rel_l1").get<double>();
         e.relRmse = i.at("rel_rmse").get<double>();
@@ -306,8 +312,12 @@ BenchMeasurement measurementFromJson(const json& j) {
         e.noiseFloorL1 = i.at("noise_floor_l1").get<double>();
         e.relL1NoiseRemoved = i.at("rel_l1_noise_removed").get<double>();
         e.relRmseNoiseRemoved = i.at("rel_rmse_noise_removed").get<double>();
-        m.image = e;
-    }
+        return e;
+    };
+    if (const json& i = j.at("image"); !i.is_null())
+        m.image = imageFromJson(i);
+    if (const json& i = j.at("image_blocks"); !i.is_null())
+        m.imageBlocks = imageFromJson(i);
     if (const json& p = j.at("probe"); !p.is_null())
         m.probe = ProbeError{p.at("mae_v").get<double>(), p.at("mae_ts").get<double>(),
                              p.at("bias_n").get<double>(), p.at("mean_n_ref").get<double>()};

@@ -185,9 +185,13 @@ BenchMeasurement runJob(const BenchJob& job) {
     if (job.block > 0)
         m.image = compareImages(hairRadianceOf(film).boxFiltered(job.block),
                                 readComparedImage(job.referenceImage).boxFiltered(job.block));
-    else if (!job.referenceImage.empty())
-        m.image = compareImages(ComparedImage::beautyOf(film, kHairAlphaLayer),
-                                readComparedImage(job.referenceImage));
+    else if (!job.referenceImage.empty()) {
+        const ComparedImage beauty = ComparedImage::beautyOf(film, kHairAlphaLayer);
+        const ComparedImage reference = readComparedImage(job.referenceImage);
+        m.image = compareImages(beauty, reference);
+        m.imageBlocks = compareImages(beauty.boxFiltered(kAccuracyBlock),
+                                      reference.boxFiltered(kAccuracyBlock));
+    }
     film = Film();
     if (job.probePoints > 0 && !job.probeFiles.empty()) {
         const std::vector<GlobalTermQuery> points = probePointsOf(scene, job, nullptr);

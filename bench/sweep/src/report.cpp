@@ -184,7 +184,11 @@ std::string csvText(const std::vector<BenchRow>& rows) {
             csvOptional(m.image ? std::optional(m.image->relL1NoiseRemoved) : std::nullopt),
             m.pathTrace ? std::to_string(m.pathTrace->spp) : "",
             csvOptional(m.pathTrace ? std::optional(m.pathTrace->raysPerSecond()) : std::nullopt),
-            csvOptional(m.pathTrace ? std::optional(m.pathTrace->pathsPerSecond()) : std::nullopt)};
+            csvOptional(m.pathTrace ? std::optional(m.pathTrace->pathsPerSecond()) : std::nullopt),
+            csvOptional(m.imageBlocks ? std::optional(m.imageBlocks->relL1) : std::nullopt),
+            csvOptional(m.imageBlocks ? std::optional(m.imageBlocks->noiseFloorL1) : std::nullopt),
+            csvOptional(m.imageBlocks ? std::optional(m.imageBlocks->relL1NoiseRemoved)
+                                      : std::nullopt)};
         for (std::size_t i = 0; i < cells.size(); ++i) {
             // Scene labels are the only free text: quote them if they need it.
             const bool quote = cells[i].find_first_of(",\"\n") != std::string::npos;
@@ -242,7 +246,11 @@ std::string markdownText(const SweepOptions& o, const SweepResult& result, const
                  "independent halves of K/2 rays (different seeds), and the rel L1 its noise "
                  "alone gives (`floor`) is measured from them and removed from every error "
                  "(`noise removed` = sqrt(L1² − floor²), film/image_compare.h); an error within "
-                 "1.5× the floor is not resolved and is marked ~.\n\n");
+                 "1.5× the floor is not resolved and is marked ~. The same errors over the means "
+                 "of ", kAccuracyBlock, "×", kAccuracyBlock, " pixel blocks (`", kAccuracyBlock,
+                 "×", kAccuracyBlock, " blocks`), where the reference's per-pixel noise averages "
+                 "out and an error that is there at that scale does not, resolve what the pixels "
+                 "cannot.\n\n");
 
     const std::vector<std::string> scenes = sceneOrder(rows, BenchSweepKind::Reference);
     if (!scenes.empty()) {
@@ -253,9 +261,12 @@ std::string markdownText(const SweepOptions& o, const SweepResult& result, const
         md += strCat(
             "| scene | segments | image | h0 | exact reference s | exact K=", fewestRays,
             " s | grid x1 s | grid speed-up: global term, total | grid x1 rel L1 | "
-            "noise removed | floor | MAE(V) | MAE(T_s) | approx within grid's time | its rel L1 | "
-            "noise removed |\n");
-        md += "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|\n";
+            "noise removed | floor | ", kAccuracyBlock, "×", kAccuracyBlock,
+            " blocks: noise removed | floor | MAE(V) | MAE(T_s) | approx within grid's time | "
+            "its rel L1 | noise removed | ", kAccuracyBlock, "×", kAccuracyBlock,
+            " blocks |\n");
+        md += "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|"
+              "---:|---:|\n";
         for (const std::string& s : scenes) {
             const BenchRow* ref = findRow(
                 rows, s, [](const BenchRow& r) { return r.kind == BenchSweepKind::Reference; });
@@ -285,18 +296,25 @@ std::string markdownText(const SweepOptions& o, const SweepResult& result, const
             const auto relL1 = [](const BenchRow* r) {
                 return r && r->m.image ? std::optional(r->m.image->relL1) : std::nullopt;
             };
-            const auto removed = [](const BenchRow* r) {
-                if (!r || !r->m.image)
+            const auto removedText = [](const std::optional<ImageError>& e) {
+                if (!e)
                     return std::string("–");
-                return strCat(r->m.image->resolved() ? "" : "~",
-                              format("%.4f", r->m.image->relL1NoiseRemoved));
+                return strCat(e->resolved() ? "" : "~", format("%.4f", e->relL1NoiseRemoved));
+            };
+            const auto removed = [&](const BenchRow* r) {
+                return r ? removedText(r->m.image) : std::string("–");
+            };
+            const auto removedBlocks = [&](const BenchRow* r) {
+                return r ? removedText(r->m.imageBlocks) : std::string("–");
+            };
+            const auto floorOf = [](const std::optional<ImageError>& e) {
+                return e ? std::optional(e->noiseFloorL1) : std::nullopt;
             };
             line += strCat(
                 " | ", mdOptional(relL1(grid), 4), " | ", removed(grid), " | ",
-                mdOptional(grid && grid->m.image ? std::optional(grid->m.image->noiseFloorL1)
-                                                 : std::nullopt,
-                           4),
-                " | ",
+                mdOptional(grid ? floorOf(grid->m.image) : std::nullopt, 4), " | ",
+                removedBlocks(grid), " | ",
+                mdOptional(grid ? floorOf(grid->m.imageBlocks) : std::nullopt, 4), " | ",
                 mdOptional(
                     grid && grid->m.probe ? std::optional(grid->m.probe->maeV) : std::nullopt, 4),
                 " | ",
@@ -323,7 +341,8 @@ std::string markdownText(const SweepOptions& o, const SweepResult& result, const
             line += approx ? strCat(approx->config.label(), " (", seconds(approx->m.totalSeconds),
                                     " s", withinBudget ? "" : ", none was as fast", ")")
                            : std::string("–");
-            line += strCat(" | ", mdOptional(relL1(approx), 4), " | ", removed(approx), " |\n");
+            line += strCat(" | ", mdOptional(relL1(approx), 4), " | ", removed(approx), " | ",
+                           removedBlocks(approx), " |\n");
             md += line;
         }
         md += "\n";
@@ -337,8 +356,10 @@ std::string markdownText(const SweepOptions& o, const SweepResult& result, const
             md += strCat(thousands(ref->m.segments), " segments, ", imageSize(*ref),
                          ", h0 = ", format("%.4g", ref->m.defaultVoxelSize), "\n\n");
         md += strCat("| configuration | voxel or radius | shading ", stageHeader(),
-                     " rel L1 | rel RMSE | MAE(V) | MAE(T_s) |\n");
-        md += "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+                     " rel L1 | rel RMSE | ", kAccuracyBlock, "×", kAccuracyBlock,
+                     " blocks: rel L1 | noise removed | MAE(V) | MAE(T_s) |\n");
+        md += "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+              "---:|\n";
         for (const BenchRow& r : rows) {
             if (r.scene != s ||
                 (r.kind != BenchSweepKind::Reference && r.kind != BenchSweepKind::Accuracy))
@@ -349,6 +370,12 @@ std::string markdownText(const SweepOptions& o, const SweepResult& result, const
                 toString(r.config.shadingRate), " |", stageCells(m), " ",
                 mdOptional(m.image ? std::optional(m.image->relL1) : std::nullopt, 4), " | ",
                 mdOptional(m.image ? std::optional(m.image->relRmse) : std::nullopt, 4), " | ",
+                mdOptional(m.imageBlocks ? std::optional(m.imageBlocks->relL1) : std::nullopt, 4),
+                " | ",
+                m.imageBlocks ? strCat(m.imageBlocks->resolved() ? "" : "~",
+                                       format("%.4f", m.imageBlocks->relL1NoiseRemoved))
+                              : std::string("–"),
+                " | ",
                 mdOptional(m.probe ? std::optional(m.probe->maeV) : std::nullopt, 4), " | ",
                 mdOptional(m.probe ? std::optional(m.probe->maeT_s) : std::nullopt, 4), " |\n");
         }
