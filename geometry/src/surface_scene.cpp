@@ -188,6 +188,36 @@ bool SurfaceScene::occluded(const Vec3f& origin, const Vec3f& dir, float tMax) c
     return ray.tfar < 0; // Embree marks an occluded ray with tfar = −∞
 }
 
+void SurfaceScene::occluded(std::span<const Vec3f> origins, std::span<const Vec3f> dirs,
+                            std::span<const float> tMax, std::span<std::uint8_t> blocked) const {
+    // Spheres and the bounding box per segment; the rest go to Embree together.
+    std::vector<RTCRay> rays;
+    std::vector<std::uint32_t> rayOf;
+    for (std::size_t i = 0; i < origins.size(); ++i) {
+        blocked[i] = 0;
+        if (empty() || !segmentMeetsBox(bounds_, origins[i], dirs[i], tMax[i]))
+            continue;
+        for (const Sphere& s : spheres_)
+            if (s.intersects(origins[i], dirs[i], tMax[i])) {
+                blocked[i] = 1;
+                break;
+            }
+        if (blocked[i] || !embree_)
+            continue;
+        rays.push_back(makeRay(origins[i], dirs[i], tMax[i]));
+        rayOf.push_back(static_cast<std::uint32_t>(i));
+    }
+    if (rays.empty())
+        return;
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    rtcOccluded1M(embree_->scene, &context, rays.data(), static_cast<unsigned>(rays.size()),
+                  sizeof(RTCRay));
+    for (std::size_t k = 0; k < rays.size(); ++k)
+        blocked[rayOf[k]] = rays[k].tfar < 0 ? 1 : 0; // Embree marks an occluded ray with tfar = −∞
+}
+
 bool SurfaceScene::contains(const Vec3f& p) const {
     for (const Sphere& s : spheres_)
         if (s.contains(p))

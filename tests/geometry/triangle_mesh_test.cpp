@@ -4,6 +4,7 @@
 #include "test_util.h"
 
 #include <hairvox/core/error.h>
+#include <hairvox/core/rng.h>
 #include <hairvox/geometry/ray_scene.h>
 #include <hairvox/geometry/surface_scene.h>
 #include <hairvox/geometry/triangle_mesh.h>
@@ -11,7 +12,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <string>
+#include <vector>
 
 namespace hairvox {
 namespace {
@@ -134,6 +137,41 @@ TEST(SurfaceScene, HitsOcclusionAndTwoSidedNormals) {
     EXPECT_TRUE(scene.contains(Vec3f(0.0f, 0.0f, 5.5f)));
     EXPECT_FALSE(scene.contains(Vec3f(0.0f, 0.0f, 2.5f)));
     EXPECT_FALSE(scene.contains(Vec3f(3.0f, 0.0f, 0.0f)));
+}
+
+TEST(SurfaceScene, ABatchOfShadowSegmentsIsEachSegmentAlone) {
+    // The batch (Embree's ray stream) and one segment at a time agree on every
+    // segment: toward a directional light and a point light, from points all
+    // around a mannequin head and a sphere, short and long, grazing included.
+    const Sphere cranium{Vec3f(0.0f, 1.0f, 0.0f), 0.1f};
+    const SurfaceScene scene({Sphere{Vec3f(0.3f, 1.0f, 0.0f), 0.05f}},
+                             {generateHeadMesh(cranium, 48)});
+    Pcg32 rng(4);
+    std::vector<Vec3f> origins, dirs;
+    std::vector<float> tMax;
+    const Vec3f pointLight(0.2f, 1.4f, 0.5f);
+    for (int i = 0; i < 3000; ++i) {
+        const Vec3f p = cranium.center + Vec3f(rng.uniform(-0.3f, 0.3f), rng.uniform(-0.3f, 0.3f),
+                                               rng.uniform(-0.3f, 0.3f));
+        if (i % 2 == 0) {
+            origins.push_back(p);
+            dirs.push_back(glm::normalize(Vec3f(-0.6f, 0.65f, -0.45f)));
+            tMax.push_back(i % 6 == 0 ? 0.05f : std::numeric_limits<float>::infinity());
+        } else {
+            origins.push_back(p);
+            dirs.push_back(glm::normalize(pointLight - p));
+            tMax.push_back(glm::length(pointLight - p));
+        }
+    }
+    std::vector<std::uint8_t> blocked(origins.size());
+    scene.occluded(origins, dirs, tMax, blocked);
+    int count = 0;
+    for (std::size_t i = 0; i < origins.size(); ++i) {
+        ASSERT_EQ(blocked[i] != 0, scene.occluded(origins[i], dirs[i], tMax[i])) << "segment " << i;
+        count += blocked[i];
+    }
+    EXPECT_GT(count, 100); // both answers are exercised
+    EXPECT_LT(count, 2900);
 }
 
 TEST(SurfaceScene, RaySceneMeetsTheSurfaceBeforeTheFibersBehindIt) {

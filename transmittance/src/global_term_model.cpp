@@ -42,12 +42,21 @@ public:
 
     GlobalTermStats evaluate(std::span<const GlobalTermQuery> queries,
                              std::span<GlobalTerm> out) const override {
-        std::vector<std::uint32_t> blocked;
+        // One shadow segment per query, tested together.
+        std::vector<Vec3f> origins(queries.size()), dirs(queries.size());
+        std::vector<float> tMax(queries.size());
+        std::vector<std::uint8_t> occluded(queries.size());
         for (std::size_t i = 0; i < queries.size(); ++i) {
             const Light::Path path = light_.pathFrom(queries[i].position);
-            if (surfaces_->occluded(queries[i].position, path.omega, path.distance))
-                blocked.push_back(static_cast<std::uint32_t>(i));
+            origins[i] = queries[i].position;
+            dirs[i] = path.omega;
+            tMax[i] = path.distance;
         }
+        surfaces_->occluded(origins, dirs, tMax, occluded);
+        std::vector<std::uint32_t> blocked;
+        for (std::size_t i = 0; i < queries.size(); ++i)
+            if (occluded[i])
+                blocked.push_back(static_cast<std::uint32_t>(i));
         GlobalTermStats stats;
         if (blocked.empty()) {
             // The common batch: nothing to take out, nothing to copy.

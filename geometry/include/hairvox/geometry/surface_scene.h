@@ -23,6 +23,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <vector>
 
 namespace hairvox {
@@ -54,6 +55,12 @@ public:
     /// Whether a surface lies on origin + t·dir, t ∈ (0, tMax) (a segment
     /// starting inside a sphere does). Thread-safe.
     bool occluded(const Vec3f& origin, const Vec3f& dir, float tMax) const;
+    /// occluded() for many segments at once, the meshes tested as one stream
+    /// of rays (Embree's coherent packets: a renderer's shadow rays toward a
+    /// light): blocked[i] = occluded(origins[i], dirs[i], tMax[i]) (1 or 0).
+    /// All four spans have the same size. Thread-safe.
+    void occluded(std::span<const Vec3f> origins, std::span<const Vec3f> dirs,
+                  std::span<const float> tMax, std::span<std::uint8_t> blocked) const;
     /// Whether p is inside a sphere, or inside a closed mesh: the first surface
     /// met along most of three fixed directions is seen from behind.
     bool contains(const Vec3f& p) const;
