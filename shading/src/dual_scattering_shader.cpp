@@ -50,23 +50,12 @@ detail::ShadeKernelParams kernelParams(const DualScatteringShader& shader) {
 /// then f_s^scatter(σ_f²) and f_back(σ_f²).
 std::array<float, detail::kShadeRows + detail::kShadeTermRows>
 shadeOneAngle(const DualScatteringShader& shader, const FiberAngles& a, const GlobalTerm& g) {
-    using detail::kBatchAlignment;
     const auto angles = std::bit_cast<std::array<float, detail::kAngleRows>>(a);
     const std::array<float, detail::kGlobalTermRows> term{
         g.V, g.T_s.r, g.T_s.g, g.T_s.b, g.sigma2_f.r, g.sigma2_f.g, g.sigma2_f.b};
-    std::array<float, detail::kAngleRows * kBatchAlignment> in{};
-    std::array<float, detail::kGlobalTermRows * kBatchAlignment> terms{};
-    std::array<float, (detail::kShadeRows + detail::kShadeTermRows) * kBatchAlignment> out;
-    for (std::size_t r = 0; r < angles.size(); ++r)
-        in[r * kBatchAlignment] = angles[r];
-    for (std::size_t r = 0; r < term.size(); ++r)
-        terms[r * kBatchAlignment] = term[r];
-    detail::shadeAngles(kernelParams(shader), {1, kBatchAlignment, in.data()},
-                        {1, kBatchAlignment, terms.data()}, {1, kBatchAlignment, out.data()}, true);
-    std::array<float, detail::kShadeRows + detail::kShadeTermRows> result;
-    for (std::size_t r = 0; r < result.size(); ++r)
-        result[r] = out[r * kBatchAlignment];
-    return result;
+    std::array<float, detail::kShadeRows + detail::kShadeTermRows> out;
+    detail::shadeAngle(kernelParams(shader), angles.data(), term.data(), out.data());
+    return out;
 }
 
 Rgb rgbAt(std::span<const float> values, std::size_t first) {
@@ -153,13 +142,15 @@ void DualScatteringShader::shade(ShadeBatch& batch) const {
 
 ShadeResult DualScatteringShader::shade(const Vec3f& wi, const Vec3f& wo, const Vec3f& u,
                                         const GlobalTerm& g) const {
-    ShadeBatch batch;
-    batch.reset(1);
-    batch.setView(0, wo, u);
-    batch.setIncident(0, wi, Rgb(1.0f));
-    batch.setGlobalTerm(0, g);
-    shade(batch);
-    return batch.radiance(0);
+    const std::array<float, detail::kDirectionRows> directions{wi.x, wi.y, wi.z, wo.x, wo.y,
+                                                               wo.z, u.x,  u.y,  u.z};
+    const std::array<float, detail::kGlobalTermRows> term{
+        g.V, g.T_s.r, g.T_s.g, g.T_s.b, g.sigma2_f.r, g.sigma2_f.g, g.sigma2_f.b};
+    const std::array<float, 3> irradiance{1.0f, 1.0f, 1.0f};
+    std::array<float, detail::kShadeRows> radiance{};
+    detail::shadeDirection(kernelParams(*this), directions.data(), term.data(), irradiance.data(),
+                           radiance.data());
+    return shadeResultOf(radiance);
 }
 
 ShadeResult DualScatteringShader::shade(const FiberAngles& a, const GlobalTerm& g) const {

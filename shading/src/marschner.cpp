@@ -85,19 +85,12 @@ std::ostream& operator<<(std::ostream& os, const LobeValues& v) {
 }
 
 FiberAngles FiberAngles::fromDirections(const Vec3f& wi, const Vec3f& wo, const Vec3f& u) {
-    // A batch of one through the kernel: the renderer's batches run the same code.
-    using detail::kBatchAlignment;
-    std::array<float, detail::kDirectionRows * kBatchAlignment> in{};
-    std::array<float, detail::kAngleRows * kBatchAlignment> out;
-    const std::array<const Vec3f*, 3> vectors{&wi, &wo, &u};
-    for (std::size_t v = 0; v < 3; ++v)
-        for (int c = 0; c < 3; ++c)
-            in[(3 * v + std::size_t(c)) * kBatchAlignment] = (*vectors[v])[c];
-    detail::anglesFromDirections({1, kBatchAlignment, in.data()}, {1, kBatchAlignment, out.data()});
-    std::array<float, detail::kAngleRows> fields;
-    for (std::size_t r = 0; r < fields.size(); ++r)
-        fields[r] = out[r * kBatchAlignment];
-    return std::bit_cast<FiberAngles>(fields);
+    // A point through the kernel: the renderer's batches run the same code.
+    const std::array<float, detail::kDirectionRows> in{wi.x, wi.y, wi.z, wo.x, wo.y,
+                                                       wo.z, u.x,  u.y,  u.z};
+    std::array<float, detail::kAngleRows> out;
+    detail::anglesFromDirection(in.data(), out.data());
+    return std::bit_cast<FiberAngles>(out);
 }
 
 FiberAngles FiberAngles::fromAngles(float theta_i, float theta_o, float phi, float phi_h) {
@@ -375,16 +368,10 @@ LobeValues MarschnerBcsdf::withLongitudinal(LobeValues n, const FiberAngles& a) 
 }
 
 LobeValues MarschnerBcsdf::eval(const FiberAngles& a) const {
-    using detail::kBatchAlignment;
-    const auto fields = std::bit_cast<std::array<float, detail::kAngleRows>>(a);
-    std::array<float, detail::kAngleRows * kBatchAlignment> in{};
-    std::array<float, detail::kLobeRows * kBatchAlignment> out;
-    for (std::size_t r = 0; r < fields.size(); ++r)
-        in[r * kBatchAlignment] = fields[r];
-    detail::evalMarschner(detail::marschnerView(*this), {1, kBatchAlignment, in.data()},
-                          {1, kBatchAlignment, out.data()});
-    const auto at = [&](std::size_t r) { return out[r * kBatchAlignment]; };
-    return {Rgb(at(0), at(1), at(2)), Rgb(at(3), at(4), at(5)), Rgb(at(6), at(7), at(8))};
+    const auto in = std::bit_cast<std::array<float, detail::kAngleRows>>(a);
+    std::array<float, detail::kLobeRows> out;
+    detail::evalMarschner(detail::marschnerView(*this), in.data(), out.data());
+    return std::bit_cast<LobeValues>(out);
 }
 
 namespace detail {

@@ -100,18 +100,27 @@ struct MutableBatch {
     float* data = nullptr;
 };
 
+// Batches (every lane of the widest vector).
+
 /// Angles (kAngleRows) of directions (kDirectionRows).
 void anglesFromDirections(const Batch& directions, const MutableBatch& angles);
 /// f_s per lobe (kLobeRows) at the angles (kAngleRows).
 void evalMarschner(const MarschnerView& fs, const Batch& angles, const MutableBatch& lobes);
-/// The shader from directions (production): adds E·result to `radiance`
-/// (kShadeRows), with E the irradiance per channel (3 rows).
+/// The shader from directions: adds E·result to `radiance` (kShadeRows),
+/// with E the irradiance per channel (3 rows).
 void shadeDirections(const ShadeKernelParams& p, const Batch& directions, const Batch& globalTerms,
                      const Batch& irradiance, const MutableBatch& radiance);
-/// The shader from angles (tests): writes `out`, kShadeRows rows, or
-/// kShadeRows + kShadeTermRows when `terms` is set.
-void shadeAngles(const ShadeKernelParams& p, const Batch& angles, const Batch& globalTerms,
-                 const MutableBatch& out, bool terms);
+
+// One point (one lane; the same code, the same bits): its rows as arrays.
+
+void anglesFromDirection(const float* directions, float* angles);
+void evalMarschner(const MarschnerView& fs, const float* angles, float* lobes);
+void shadeDirection(const ShadeKernelParams& p, const float* directions, const float* globalTerm,
+                    const float* irradiance, float* radiance);
+/// The shader from angles (kAngleRows): `out` gets kShadeRows and then the
+/// kShadeTermRows of f_s^scatter(σ_f²) and f_back(σ_f²).
+void shadeAngle(const ShadeKernelParams& p, const float* angles, const float* globalTerm,
+                float* out);
 
 /// The instruction set the kernel dispatches to on this CPU (e.g. "AVX3", "AVX2").
 const char* shadeKernelTarget();
