@@ -1,6 +1,6 @@
 // hairvox render [SCENE.json] [--exr OUT.exr] [--png OUT.png] [-o OUT.exr|OUT.png]
 //                [--integrator dual_scattering|path] [--mode exact|grid|approx]
-//                [--shading-rate fragment|vertex] [--exr-compression zips|zip|rle|none]
+//                [--shading-rate fragment|vertex] [--exr-compression rle|zips|zip|none]
 //                [--spp N]
 //                [--time-limit S] [--seed S] [--continue] [--width W] [--height H]
 //                [--voxel-size V] [--max-memory GIB] [--threads N] [--quiet]
@@ -202,8 +202,8 @@ void addRenderCommand(CLI::App& app) {
                     "(docs/scene.md)")
         ->check(CLI::IsMember(kShadingRateNames.names()));
     cmd->add_option("--exr-compression", opt->exrCompression,
-                    "EXR compression: zips (default), zip, rle or none (sizes and times in "
-                    "docs/scene.md)")
+                    "EXR compression: rle (default), zips, zip or none; overrides the scene's "
+                    "(sizes and times in docs/scene.md)")
         ->check(CLI::IsMember(kExrCompressionNames.names()));
     cmd->add_option("--spp", opt->spp, "Path tracing: samples per pixel [1, 1000000]");
     cmd->add_option("--time-limit", opt->timeLimit,

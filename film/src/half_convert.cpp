@@ -4,19 +4,20 @@
 #define HWY_DISABLED_TARGETS (HWY_SSSE3 | HWY_SVE | HWY_SVE2 | HWY_SVE_256 | HWY_SVE2_128 | HWY_RVV)
 #endif
 
+// Highway's order: the target list, then this file once per target.
+// clang-format off
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "film/src/half_convert.cpp"
 #include <hwy/foreach_target.h> // IWYU pragma: keep
-
 #include <hwy/highway.h>
+// clang-format on
 
 #include "half_convert.h"
-
-#include <half.h>
 
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <half.h>
 #include <limits>
 
 HWY_BEFORE_NAMESPACE();
@@ -28,10 +29,12 @@ using D = hn::ScalableTag<float>;
 
 /// Targets whose DemoteTo(float16) is the F16C instruction (round to
 /// nearest even); elsewhere Highway truncates, so Imath converts instead.
-constexpr bool kHardwareHalf = HWY_TARGET == HWY_AVX2 || HWY_TARGET == HWY_AVX3 ||
-                               HWY_TARGET == HWY_AVX3_DL;
+constexpr bool kHardwareHalf =
+    HWY_TARGET == HWY_AVX2 || HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX3_DL;
 
-std::uint16_t halfBits(float x) { return Imath::half(x).bits(); }
+std::uint16_t halfBits(float x) {
+    return Imath::half(x).bits();
+}
 
 float maxAbsScalar(const float* values, std::size_t stride, std::size_t begin, std::size_t count) {
     float m = 0;

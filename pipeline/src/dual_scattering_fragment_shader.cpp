@@ -53,8 +53,12 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
     std::fill(out.begin(), out.end(), 0.0f);
     std::vector<GlobalTermQuery> queries(points.size());
     for (std::size_t i = 0; i < points.size(); ++i)
-        queries[i] = {points[i].position, points[i].tangent, points[i].strand, true,
-                      fiberTypeAt(fiberType_, points[i].segment), points[i].segment};
+        queries[i] = {points[i].position,
+                      points[i].tangent,
+                      points[i].strand,
+                      true,
+                      fiberTypeAt(fiberType_, points[i].segment),
+                      points[i].segment};
     std::vector<GlobalTerm> terms(points.size());
     std::int64_t globalTermNanos = 0;
     std::vector<GlobalTermStats> batchStats(lightCount);

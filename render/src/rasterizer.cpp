@@ -319,10 +319,10 @@ struct TileScratch {
     std::vector<Visible> visible;
     std::vector<Visible> grouped;            ///< visible, ordered by segment
     std::vector<std::uint32_t> segmentStart; ///< per local segment: its first grouped fragment
-    std::vector<std::uint32_t> vertexSlot; ///< per local segment: slot of its root-side vertex
-    std::vector<std::uint32_t> slotPoint;  ///< per vertex slot: the point index
-    std::vector<std::uint32_t> slotStrand; ///< per vertex slot: its strand
-    std::vector<float> vertexResults;      ///< per vertex slot: stride floats
+    std::vector<std::uint32_t> vertexSlot;   ///< per local segment: slot of its root-side vertex
+    std::vector<std::uint32_t> slotPoint;    ///< per vertex slot: the point index
+    std::vector<std::uint32_t> slotStrand;   ///< per vertex slot: its strand
+    std::vector<float> vertexResults;        ///< per vertex slot: stride floats
     std::vector<ShadingPoint> points;
     std::vector<float> results;  ///< per point of a batch: stride floats
     std::vector<float> lerped;   ///< one interpolated vertex-rate result

@@ -79,7 +79,8 @@ void ShadeBatch::reset(std::size_t count) {
     // Whole vectors, plus one: rows a power of two apart (1024 points: 4 KiB)
     // would all map to the same L1 cache sets and evict each other.
     const std::size_t capacity =
-        ((count + detail::kBatchAlignment - 1) / detail::kBatchAlignment + 1) * detail::kBatchAlignment;
+        ((count + detail::kBatchAlignment - 1) / detail::kBatchAlignment + 1) *
+        detail::kBatchAlignment;
     if (capacity != capacity_) {
         capacity_ = capacity;
         // Zeros in the padding: the kernel reads whole vectors.
@@ -134,10 +135,9 @@ void DualScatteringShader::shade(ShadeBatch& batch) const {
         return;
     const std::size_t n = batch.count_, capacity = batch.capacity_;
     const float* in = batch.inputs_.data();
-    detail::shadeDirections(kernelParams(*this), {n, capacity, in},
-                            {n, capacity, in + kGlobalTermRow * capacity},
-                            {n, capacity, in + kIrradianceRow * capacity},
-                            {n, capacity, batch.radiance_.data()});
+    detail::shadeDirections(
+        kernelParams(*this), {n, capacity, in}, {n, capacity, in + kGlobalTermRow * capacity},
+        {n, capacity, in + kIrradianceRow * capacity}, {n, capacity, batch.radiance_.data()});
 }
 
 ShadeResult DualScatteringShader::shade(const Vec3f& wi, const Vec3f& wo, const Vec3f& u,

@@ -9,12 +9,14 @@
 #define HWY_DISABLED_TARGETS (HWY_SSSE3 | HWY_SVE | HWY_SVE2 | HWY_SVE_256 | HWY_SVE2_128 | HWY_RVV)
 #endif
 
+// Highway's order: the target list, then this file once per target.
+// clang-format off
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "shading/src/shade_kernel.cpp"
 #include <hwy/foreach_target.h> // IWYU pragma: keep
-
-#include <hwy/contrib/math/math-inl.h>
 #include <hwy/highway.h>
+#include <hwy/contrib/math/math-inl.h>
+// clang-format on
 
 #include "shade_kernel.h"
 
@@ -80,7 +82,9 @@ void ShadeAngle(const ShadeKernelParams& p, const float* angles, const float* gl
     single::shadeAngles(p, {1, 1, angles}, {1, 1, globalTerm}, {1, 1, out}, true);
 }
 
-const char* Target() { return hwy::TargetName(HWY_TARGET); }
+const char* Target() {
+    return hwy::TargetName(HWY_TARGET);
+}
 
 } // namespace hairvox::detail::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
@@ -121,7 +125,9 @@ void shadeAngle(const ShadeKernelParams& p, const float* angles, const float* gl
                 float* out) {
     HWY_DYNAMIC_DISPATCH(ShadeAngle)(p, angles, globalTerm, out);
 }
-const char* shadeKernelTarget() { return HWY_DYNAMIC_DISPATCH(Target)(); }
+const char* shadeKernelTarget() {
+    return HWY_DYNAMIC_DISPATCH(Target)();
+}
 
 } // namespace hairvox::detail
 #endif

@@ -69,12 +69,12 @@ inline constexpr int kWiX = 0, kWiY = 1, kWiZ = 2, kWoX = 3, kWoY = 4, kWoZ = 5,
 
 /// Rows of a batch of angles, FiberAngles' fields in order.
 inline constexpr int kSinThetaI = 0, kCosThetaI = 1, kSinThetaO = 2, kCosThetaO = 3, kThetaI = 4,
-                     kThetaO = 5, kThetaH = 6, kThetaD = 7, kCos2ThetaD = 8, kPhi = 9,
-                     kCosPhi = 10, kCos2PhiH = 11, kAngleRows = 12;
+                     kThetaO = 5, kThetaH = 6, kThetaD = 7, kCos2ThetaD = 8, kPhi = 9, kCosPhi = 10,
+                     kCos2PhiH = 11, kAngleRows = 12;
 
 /// Rows of a batch of global terms: V, then T_s and σ_f² per channel.
-inline constexpr int kV = 0, kTsR = 1, kTsG = 2, kTsB = 3, kSigma2R = 4, kSigma2G = 5,
-                     kSigma2B = 6, kGlobalTermRows = 7;
+inline constexpr int kV = 0, kTsR = 1, kTsG = 2, kTsB = 3, kSigma2R = 4, kSigma2G = 5, kSigma2B = 6,
+                     kGlobalTermRows = 7;
 
 /// Rows of a shade result: ShadeResult's five RGB components in order
 /// (directR, directTT, directTRT, backDirect, scatter), then — only when a

@@ -46,7 +46,8 @@ public:
 struct Fixture {
     Fixture() {
         const Vec3f a[3] = {{0, 0, 0}, {0.1f, 0, 0}, {0.2f, 0.01f, 0}};
-        const Vec3f b[2] = {{0, 0.05f, 0.02f}, {0.003f, 0.05f, 0.02f}}; // shorter than a sample spacing
+        const Vec3f b[2] = {{0, 0.05f, 0.02f},
+                            {0.003f, 0.05f, 0.02f}}; // shorter than a sample spacing
         groom.addStrand(a);
         groom.addStrand(b);
         Pcg32 rng(3);
@@ -62,7 +63,9 @@ struct Fixture {
     std::vector<GlobalTermQuery> queries;
 };
 
-std::uint32_t bitsOf(float x) { return std::bit_cast<std::uint32_t>(x); }
+std::uint32_t bitsOf(float x) {
+    return std::bit_cast<std::uint32_t>(x);
+}
 
 TEST(AlongFibers, InterpolatesBetweenSamplesOnTheSegment) {
     const Fixture f;
@@ -164,7 +167,8 @@ TEST(AlongFibers, GridSampledAVoxelApartMatchesEveryPoint) {
     every.fiberSampleSpacing = 0;
     sampled.fiberSampleSpacing = 1;
     const Light light = Light::directional(glm::normalize(Vec3f(0.3f, 1, 0.2f)));
-    const auto everyModel = makeGridModel(grid, {test::constantTable(0.6f, 0.02f)}, settings, every);
+    const auto everyModel =
+        makeGridModel(grid, {test::constantTable(0.6f, 0.02f)}, settings, every);
     const auto sampledModel =
         makeGridModel(grid, {test::constantTable(0.6f, 0.02f)}, settings, sampled);
     const auto a = everyModel->forLight(light);
@@ -184,7 +188,8 @@ TEST(AlongFibers, GridSampledAVoxelApartMatchesEveryPoint) {
     EXPECT_LT(stats.evaluated * 3, stats.queries);
     double meanAbsV = 0, meanV = 0;
     for (std::size_t i = 0; i < queries.size(); ++i) {
-        meanAbsV += std::abs(double(exact[i].V) - double(interpolated[i].V)) / double(queries.size());
+        meanAbsV +=
+            std::abs(double(exact[i].V) - double(interpolated[i].V)) / double(queries.size());
         meanV += double(exact[i].V) / double(queries.size());
     }
     EXPECT_GT(meanV, 0.05);

@@ -11,7 +11,9 @@ namespace hairvox {
 namespace {
 
 GlobalTerm lerp(float f, const GlobalTerm& a, const GlobalTerm& b) {
-    const auto mix = [f](const auto& x, const auto& y) { return x + f * (y - x); };
+    const auto mix = [f](const auto& x, const auto& y) {
+        return x + f * (y - x);
+    };
     GlobalTerm g;
     g.n = mix(a.n, b.n);
     g.V = mix(a.V, b.V);
@@ -59,7 +61,8 @@ public:
             const float scale = length2 > 0 ? float(m) / length2 : 0.0f;
             std::size_t end = i;
             int kMin = m, kMax = 0;
-            for (; end < queries.size() && queries[end].segment == q.segment && queries[end].onFiber;
+            for (;
+                 end < queries.size() && queries[end].segment == q.segment && queries[end].onFiber;
                  ++end) {
                 const float x =
                     std::clamp(glm::dot(queries[end].position - p0, d) * scale, 0.0f, float(m));

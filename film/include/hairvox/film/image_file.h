@@ -43,19 +43,10 @@ using Matrix44 = std::array<std::array<float, 4>, 4>;
 inline constexpr int kDefaultExrZipLevel = 1;
 
 /// How the EXR's pixels are compressed (OpenEXR's lossless schemes; the names
-/// are OpenEXR's). Measured with `hairvox render`'s write stage on 2 cores,
-/// 43 channels (the EXR with the PNG encoded beside it), zlib level 1:
-///
-/// | compression | default scene 1024² | head_1p4m 1920×1080 |
-/// |-------------|---------------------|---------------------|
-/// | zips        | 0.39–0.42 s, 21.4 MB | 0.60–0.61 s, 21.2 MB |
-/// | zip         | 0.42–0.43 s, 21.2 MB | 0.56–0.58 s, 20.9 MB |
-/// | rle         | 0.21–0.27 s, 26.3 MB | 0.44–0.48 s, 27.4 MB |
-/// | none        | 0.16–0.20 s, 92 MB   | 0.33–0.35 s, 182 MB  |
-///
-/// zips (zlib per scanline) is the default: the smallest files for ~0.2 s
-/// more than rle per megapixel; rle for write-bound batch renders; none
-/// costs 4–9× the disk for what is left of the conversion and the I/O.
+/// are OpenEXR's). rle is the default: the 1080p head's 43 channels in
+/// 0.27–0.30 s for 27 MB, against 0.44–0.52 s for 21 MB with zips (zlib
+/// level 1) and 0.22–0.24 s for 182 MB with none (the EXR alone, 2 threads;
+/// docs/scene.md "Output" has the table).
 enum class ExrCompression { Zips, Zip, Rle, None };
 
 inline constexpr EnumNames<ExrCompression, 4> kExrCompressionNames{{{
