@@ -173,6 +173,15 @@ TEST(BenchSweep, TinySweepWritesTablesAndPlots) {
             EXPECT_LT(std::stod(csv[r][column("rel_l1")]), 1.0);
             // The exact reference's two halves (1 ray each over the h0 disk) give its floor.
             EXPECT_GT(std::stod(csv[r][column("noise_floor_l1")]), 0.0) << r;
+            // Over 4×4 block means the reference's noise averages out: a lower floor.
+            EXPECT_LT(std::stod(csv[r][column("block_noise_floor_l1")]),
+                      std::stod(csv[r][column("noise_floor_l1")]))
+                << r;
+            EXPECT_LE(std::stod(csv[r][column("block_rel_l1_noise_removed")]),
+                      std::stod(csv[r][column("block_rel_l1")]))
+                << r;
+        } else {
+            EXPECT_EQ(csv[r][column("block_rel_l1")], "") << r;
         }
         if (model) {
             // Against a noisy 8-spp reference: the floor is known and positive.
@@ -202,13 +211,15 @@ TEST(BenchSweep, TinySweepWritesTablesAndPlots) {
     const std::string text((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
     for (const char* needle :
          {"## Summary", "| tiny | 3,300 | 64×64 |", "## tiny", "| exact K=2 (reference) |",
+          "4×4 blocks: noise removed | floor |",
           "| grid x1 | 0.012 | vertex |", "## Scaling with segment count",
           "## Scaling with image size", "cost ∝ pixels^k: total time k = ",
           "## Model error: dual scattering against path tracing", "| tiny, dark | grid | "})
         EXPECT_NE(text.find(needle), std::string::npos) << needle << "\n" << text;
 
-    // matplotlib figures (bench/sweep/plot_sweep.py): 11 × 6.5 in and 2 × 7 × 5.2 in at 120 dpi.
-    EXPECT_EQ(pngSize(o.outDir / "runtime_vs_error.png"), std::make_pair(1320u, 780u));
+    // matplotlib figures (bench/sweep/plot_sweep.py): 14 × 6.5 in at 110 dpi (per pixel and
+    // over blocks) and 2 × 7 × 5.2 in at 120 dpi.
+    EXPECT_EQ(pngSize(o.outDir / "runtime_vs_error.png"), std::make_pair(1540u, 715u));
     EXPECT_EQ(pngSize(o.outDir / "scaling.png"), std::make_pair(1680u, 624u));
     EXPECT_FALSE(std::filesystem::exists(o.outDir / ".work")) << "working files are removed";
 }
