@@ -99,17 +99,24 @@ void BM_MarschnerEvalExact(benchmark::State& state) {
     });
 }
 
-/// The full shader at one point at a time (a batch of one: the SIMD lanes
-/// mostly idle): direct and scattered light both present (no component
-/// skipped). Argument: coherent inputs.
-void BM_ShaderShade(benchmark::State& state) {
-    const DualScatteringShader& shader = shading().shader;
+/// A global term with direct and scattered light both present (no
+/// component of the shader skipped).
+GlobalTerm partlyShadowed() {
     GlobalTerm g;
     g.n = 2;
     g.V = std::exp(-2.0f);
     g.P = Rgb(0.5f, 0.4f, 0.3f);
     g.T_s = 0.7f * (g.P - Rgb(g.V));
     g.sigma2_f = Rgb(0.02f, 0.021f, 0.022f);
+    return g;
+}
+
+/// The full shader at one point at a time (a batch of one: the SIMD lanes
+/// mostly idle): direct and scattered light both present (no component
+/// skipped). Argument: coherent inputs.
+void BM_ShaderShade(benchmark::State& state) {
+    const DualScatteringShader& shader = shading().shader;
+    const GlobalTerm g = partlyShadowed();
     loop(
         state, [&](const Inputs& in, std::size_t k) { return shader.shade(in.wi[k], in.wo[k], in.u[k], g); },
         state.range(0) != 0);
@@ -121,12 +128,7 @@ void BM_ShaderShade(benchmark::State& state) {
 void BM_ShaderShadeBatch(benchmark::State& state) {
     const DualScatteringShader& shader = shading().shader;
     const Inputs& in = inputs(state.range(0) != 0);
-    GlobalTerm g;
-    g.n = 2;
-    g.V = std::exp(-2.0f);
-    g.P = Rgb(0.5f, 0.4f, 0.3f);
-    g.T_s = 0.7f * (g.P - Rgb(g.V));
-    g.sigma2_f = Rgb(0.02f, 0.021f, 0.022f);
+    const GlobalTerm g = partlyShadowed();
     constexpr std::size_t kBatch = 1024;
     ShadeBatch batch;
     std::size_t first = 0;

@@ -45,6 +45,22 @@ float maxAbsScalar(const float* values, std::size_t stride, std::size_t begin, s
     return m;
 }
 
+/// Whole vectors are read only up to this many values: with stride 3 a
+/// vector reads 3·lanes floats from the channel's first, which for the last
+/// value would pass the end of the layer.
+std::size_t vectorCount(std::size_t stride, std::size_t count) {
+    return stride == 3 ? (count > 0 ? count - 1 : 0) : count;
+}
+
+/// Values i, i + 1, ... of a channel `stride` (1 or 3) floats apart.
+hn::Vec<D> loadChannel(const float* values, std::size_t stride, std::size_t i) {
+    if (stride != 3)
+        return hn::LoadU(D(), values + i);
+    hn::Vec<D> v, g, b;
+    hn::LoadInterleaved3(D(), values + 3 * i, v, g, b);
+    return v;
+}
+
 } // namespace
 
 float MaxAbs(const float* values, std::size_t stride, std::size_t count);
@@ -55,18 +71,9 @@ float MaxAbs(const float* values, std::size_t stride, std::size_t count) {
     const std::size_t lanes = hn::Lanes(d);
     auto m = hn::Zero(d);
     auto nan = hn::FirstN(d, 0); // no lane
-    // Whole vectors only where they stay inside the channel's floats (with
-    // stride 3 a vector reads 3·lanes floats from the channel's first).
-    const std::size_t vectors = stride == 3 ? (count > 0 ? count - 1 : 0) : count;
     std::size_t i = 0;
-    for (; i + lanes <= vectors; i += lanes) {
-        hn::Vec<D> v;
-        if (stride == 3) {
-            hn::Vec<D> g, b;
-            hn::LoadInterleaved3(d, values + 3 * i, v, g, b);
-        } else {
-            v = hn::LoadU(d, values + i);
-        }
+    for (; i + lanes <= vectorCount(stride, count); i += lanes) {
+        const hn::Vec<D> v = loadChannel(values, stride, i);
         nan = hn::Or(nan, hn::IsNaN(v));
         m = hn::Max(m, hn::Abs(v));
     }
@@ -81,18 +88,9 @@ void ToHalf(const float* values, std::size_t stride, std::size_t count, std::uin
         const D d;
         const hn::Rebind<hwy::float16_t, D> d16;
         const std::size_t lanes = hn::Lanes(d);
-        const std::size_t vectors = stride == 3 ? (count > 0 ? count - 1 : 0) : count;
         auto* out16 = reinterpret_cast<hwy::float16_t*>(out);
-        for (; i + lanes <= vectors; i += lanes) {
-            hn::Vec<D> v;
-            if (stride == 3) {
-                hn::Vec<D> g, b;
-                hn::LoadInterleaved3(d, values + 3 * i, v, g, b);
-            } else {
-                v = hn::LoadU(d, values + i);
-            }
-            hn::StoreU(hn::DemoteTo(d16, v), d16, out16 + i);
-        }
+        for (; i + lanes <= vectorCount(stride, count); i += lanes)
+            hn::StoreU(hn::DemoteTo(d16, loadChannel(values, stride, i)), d16, out16 + i);
     }
     for (; i < count; ++i)
         out[i] = halfBits(values[i * stride]);
