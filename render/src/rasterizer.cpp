@@ -108,6 +108,7 @@ struct RenderContext {
     std::vector<Vec3f> tangents;
     std::vector<raster::ProjectedVertex> projected; ///< per point
     std::vector<std::uint32_t> firstPoint; ///< per segment: the point index of its root-side vertex
+    std::vector<std::uint32_t> strandOf;   ///< per segment: its strand
     int tilesX = 0, tilesY = 0;
     /// Per tile: the farthest surface depth if surfaces cover every pixel wholly, else +∞.
     std::vector<float> tileSurfaceDepth;
@@ -139,10 +140,7 @@ struct RenderContext {
             0.5f * ribbonWidthAt(groom, settings.fiberScale, k),
             0.5f * ribbonWidthAt(groom, settings.fiberScale, k + 1), camera.nearClip());
     }
-    std::uint32_t strandOfPoint(std::uint32_t point) const {
-        const auto it = std::upper_bound(groom.strandStart.begin(), groom.strandStart.end(), point);
-        return static_cast<std::uint32_t>(it - groom.strandStart.begin() - 1);
-    }
+
 };
 
 /// Per tile, the depth behind which surfaces hide everything: the farthest
@@ -172,13 +170,18 @@ std::vector<float> tileSurfaceDepths(const SurfaceLayer& surfaces, int width, in
     return depth;
 }
 
-std::vector<std::uint32_t> segmentFirstPoints(const Groom& groom) {
-    std::vector<std::uint32_t> first;
-    first.reserve(groom.segmentCount());
+/// Per segment, its root-side point and its strand.
+void indexSegments(const Groom& groom, std::vector<std::uint32_t>& firstPoint,
+                   std::vector<std::uint32_t>& strandOf) {
+    firstPoint.clear();
+    strandOf.clear();
+    firstPoint.reserve(groom.segmentCount());
+    strandOf.reserve(groom.segmentCount());
     for (std::size_t s = 0; s < groom.strandCount(); ++s)
-        for (std::uint32_t k = groom.strandStart[s]; k + 1 < groom.strandStart[s + 1]; ++k)
-            first.push_back(k);
-    return first;
+        for (std::uint32_t k = groom.strandStart[s]; k + 1 < groom.strandStart[s + 1]; ++k) {
+            firstPoint.push_back(k);
+            strandOf.push_back(static_cast<std::uint32_t>(s));
+        }
 }
 
 /// Bins segments to the tiles their ribbon may touch. Chunks of segments are
@@ -425,7 +428,7 @@ private:
             s_.ribbons[i] = *ctx_.ribbon(bins_[i]);
             s_.zMin[i] = 1.0f / std::max(s_.ribbons[i].invZ0, s_.ribbons[i].invZ1);
             s_.pointOf[i] = ctx_.firstPoint[bins_[i]];
-            s_.strandOf[i] = ctx_.strandOfPoint(s_.pointOf[i]);
+            s_.strandOf[i] = ctx_.strandOf[bins_[i]];
             // (zMin, index) as one integer: positive floats order like their bits.
             s_.keys[i] = (std::uint64_t(std::bit_cast<std::uint32_t>(s_.zMin[i])) << 32) | i;
         }
@@ -820,7 +823,7 @@ RasterOutput rasterize(const Groom& groom, const Camera& camera, const FragmentS
     ctx.film = &film;
 
     prepareVertices(groom, ctx.camera, settings.fiberScale, ctx.tangents, ctx.projected);
-    ctx.firstPoint = segmentFirstPoints(groom);
+    indexSegments(groom, ctx.firstPoint, ctx.strandOf);
     ctx.tilesX = (ctx.camera.width() + kTileSize - 1) / kTileSize;
     ctx.tilesY = (ctx.camera.height() + kTileSize - 1) / kTileSize;
     ctx.tileSurfaceDepth =
