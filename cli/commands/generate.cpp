@@ -4,6 +4,7 @@
 
 #include <hairvox/core/error.h>
 #include <hairvox/core/format.h>
+#include <hairvox/pipeline/pipeline.h>
 #include <hairvox/strands/groom_io.h>
 #include <hairvox/strands/procedural.h>
 
@@ -23,6 +24,16 @@ struct GenerateOptions {
 void runGenerate(const GenerateOptions& opt) {
     ProceduralGroomParams params = opt.params;
     params.style = *kGroomStyleNames.parse(opt.style); // CLI11 checked the choice
+    params.validate();
+    // The points, their copy in the file's encoding and the strand index:
+    // refused before anything is allocated if that is beyond the machine.
+    const std::uint64_t bytes =
+        std::uint64_t(params.strands) * params.resolvedPointsPerStrand() * 2 * sizeof(Vec3f);
+    if (bytes > defaultMemoryLimit())
+        throw InputError(strCat("--strands ", params.strands, " × --points-per-strand ",
+                                params.resolvedPointsPerStrand(), " needs ~", bytes >> 20,
+                                " MiB, more than the ", defaultMemoryLimit() >> 20,
+                                " MiB this machine allows (3/4 of its memory)"));
     const Groom groom = generateGroom(params);
     writeHairFile(opt.output, groom, strCat("hairvox generate ", opt.style));
     std::cout << "wrote " << opt.output << ": " << thousands(groom.strandCount()) << " "

@@ -3,8 +3,11 @@
 #include <hairvox/core/rng.h>
 #include <hairvox/strands/procedural.h>
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 namespace hairvox {
@@ -29,6 +32,12 @@ void requireRange(const char* name, T value, T lo, T hi) {
 void ProceduralGroomParams::validate() const {
     requireRange("strands", strands, 1u, 10'000'000u);
     requireRange("points per strand", resolvedPointsPerStrand(), 2u, 4096u);
+    // Points are indexed by 32 bits (Groom::strandStart).
+    if (const std::uint64_t total = std::uint64_t(strands) * resolvedPointsPerStrand();
+        total > std::numeric_limits<std::uint32_t>::max())
+        throw InputError(strCat("procedural groom: ", strands, " strands × ",
+                                resolvedPointsPerStrand(), " points = ", total,
+                                " points, more than the 4,294,967,295 a groom can index"));
     if (!isFinite(headCenter))
         throw InputError("procedural groom: head centre must be finite");
     requireRange("head radius", headRadius, 1e-4f, 1e3f);
@@ -237,10 +246,16 @@ Groom generateGroom(const ProceduralGroomParams& params) {
             params.colors.size() - 1)]);
     }
 
+    // Every strand has `points` points and a random stream of its own: they
+    // are grown in parallel into their places (the same bytes for any thread count).
     Groom groom;
-    groom.points.reserve(std::uint64_t(params.strands) * points);
-    groom.strandStart.reserve(params.strands + 1u);
-    for (std::uint32_t i = 0; i < params.strands; ++i) {
+    groom.points.resize(std::size_t(params.strands) * points);
+    groom.strandStart.resize(std::size_t(params.strands) + 1);
+    for (std::uint32_t i = 0; i <= params.strands; ++i)
+        groom.strandStart[i] = i * points;
+    if (!clumpColor.empty())
+        groom.color.resize(groom.points.size());
+    tbb::parallel_for(std::uint32_t(0), params.strands, [&](std::uint32_t i) {
         Pcg32 rng(params.seed, 0x57a4dull + 2ull * i);
         const Vec3f& root = roots[i];
         std::uint32_t clump = 0;
@@ -265,12 +280,12 @@ Groom generateGroom(const ProceduralGroomParams& params) {
             line[k] = lerp(w, line[k], target);
         }
         addStyleOffsets(line, params, looks[clump], 0.15f * normalVariate(rng));
-        for (Vec3f& p : line)
-            p = head.pushOut(p, head.radius * 1.003f);
-        groom.addStrand(line);
+        const std::size_t first = std::size_t(i) * points;
+        for (std::uint32_t k = 0; k < points; ++k)
+            groom.points[first + k] = head.pushOut(line[k], head.radius * 1.003f);
         if (!clumpColor.empty())
-            groom.color.insert(groom.color.end(), line.size(), clumpColor[clump]);
-    }
+            std::fill_n(groom.color.begin() + std::ptrdiff_t(first), points, clumpColor[clump]);
+    });
     return groom;
 }
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <sstream>
 
 namespace hairvox {
@@ -68,6 +69,16 @@ TEST(Cli, BadUsageAndBadInputExitWith2) {
     EXPECT_EQ(test::runHairvox("frobnicate").exitCode, 2);
     EXPECT_EQ(test::runHairvox("generate spiky -o x.hair").exitCode, 2);
     EXPECT_EQ(test::runHairvox("generate wavy --strands 0 -o x.hair").exitCode, 2);
+    // Beyond a groom's 32-bit point index, and beyond the machine's memory:
+    // refused before anything is allocated, naming the options.
+    for (const char* huge : {"--strands 10000000 --points-per-strand 4096",
+                             "--strands 10000000 --points-per-strand 400"}) {
+        const auto g = test::runHairvox(std::string("generate wavy ") + huge + " -o '" +
+                                        (dir / "huge.hair").string() + "'");
+        EXPECT_EQ(g.exitCode, 2) << g.output;
+        EXPECT_NE(g.output.find("points"), std::string::npos) << g.output;
+        EXPECT_FALSE(std::filesystem::exists(dir / "huge.hair"));
+    }
     test::writeText(dir / "bad.hair", "HAIR but not really");
     const auto r = test::runHairvox("info '" + (dir / "bad.hair").string() + "'");
     EXPECT_EQ(r.exitCode, 2);
