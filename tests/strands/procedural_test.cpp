@@ -1,4 +1,5 @@
 #include <hairvox/core/error.h>
+#include <hairvox/core/parallel.h>
 #include <hairvox/strands/procedural.h>
 
 #include <gtest/gtest.h>
@@ -29,6 +30,24 @@ TEST_P(ProceduralStyles, DeterministicBySeed) {
     const Groom c = generateGroom(paramsFor(GetParam(), 500, 4));
     EXPECT_TRUE(samePoints(a, b));
     EXPECT_FALSE(samePoints(a, c));
+}
+
+TEST_P(ProceduralStyles, TheSameBytesWithAnyThreadCount) {
+    // Strands are grown in parallel, each from its own random stream.
+    ProceduralGroomParams p = paramsFor(GetParam(), 3000, 7);
+    p.colors = {Rgb(0.8f, 0.6f, 0.3f), Rgb(0.2f, 0.1f, 0.05f)};
+    Groom one;
+    {
+        const ThreadLimit limit(1);
+        one = generateGroom(p);
+    }
+    for (int threads : {2, 8}) {
+        const ThreadLimit limit(threads);
+        const Groom many = generateGroom(p);
+        EXPECT_TRUE(samePoints(one, many)) << threads << " threads";
+        EXPECT_EQ(one.strandStart, many.strandStart);
+        EXPECT_EQ(one.color, many.color);
+    }
 }
 
 TEST_P(ProceduralStyles, ShapedLikeHairOnAHead) {
