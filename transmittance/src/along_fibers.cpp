@@ -57,15 +57,19 @@ public:
             // The run of queries on this segment, each at t = x/m, x ∈ [k, k + 1].
             const Vec3f p0 = points_[q.segment], d = points_[q.segment + 1] - p0;
             const float length2 = glm::dot(d, d);
-            const int m = std::max(1, static_cast<int>(std::ceil(std::sqrt(length2) / spacing_)));
+            // (At least 1 — also for a NaN length — and capped, so that an
+            // absurd length/spacing ratio cannot overflow the sample index.)
+            const float ratio = std::sqrt(length2) / spacing_;
+            const int m =
+                ratio > 1.0f ? static_cast<int>(std::min(std::ceil(ratio), float(1 << 30))) : 1;
             const float scale = length2 > 0 ? float(m) / length2 : 0.0f;
             std::size_t end = i;
             int kMin = m, kMax = 0;
             for (;
                  end < queries.size() && queries[end].segment == q.segment && queries[end].onFiber;
                  ++end) {
-                const float x =
-                    std::clamp(glm::dot(queries[end].position - p0, d) * scale, 0.0f, float(m));
+                const float along = glm::dot(queries[end].position - p0, d) * scale;
+                const float x = along > 0 ? std::min(along, float(m)) : 0.0f; // NaN → 0
                 const int k = std::min(static_cast<int>(x), m - 1);
                 where[end] = {static_cast<std::uint32_t>(k), x - float(k)};
                 kMin = std::min(kMin, k);
