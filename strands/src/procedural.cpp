@@ -32,12 +32,6 @@ void requireRange(const char* name, T value, T lo, T hi) {
 void ProceduralGroomParams::validate() const {
     requireRange("strands", strands, 1u, 10'000'000u);
     requireRange("points per strand", resolvedPointsPerStrand(), 2u, 4096u);
-    // Points are indexed by 32 bits (Groom::strandStart).
-    if (const std::uint64_t total = std::uint64_t(strands) * resolvedPointsPerStrand();
-        total > std::numeric_limits<std::uint32_t>::max())
-        throw InputError(strCat("procedural groom: ", strands, " strands × ",
-                                resolvedPointsPerStrand(), " points = ", total,
-                                " points, more than the 4,294,967,295 a groom can index"));
     if (!isFinite(headCenter))
         throw InputError("procedural groom: head centre must be finite");
     requireRange("head radius", headRadius, 1e-4f, 1e3f);
@@ -219,6 +213,13 @@ float lengthFactor(const ProceduralGroomParams& params) {
 Groom generateGroom(const ProceduralGroomParams& params) {
     params.validate();
     const std::uint32_t points = params.resolvedPointsPerStrand();
+    // Points are indexed by 32 bits (Groom::strandStart); a scene caps them
+    // lower (pipeline's kMaxProceduralPoints), a library caller may not.
+    if (const std::uint64_t total = std::uint64_t(params.strands) * points;
+        total > std::numeric_limits<std::uint32_t>::max())
+        throw InputError(strCat("procedural groom: ", params.strands, " strands × ", points,
+                                " points = ", total,
+                                " points, more than the 4,294,967,295 a groom can index"));
     const HeadSphere head{params.headCenter, params.headRadius};
     const float centrelineLength = params.length / lengthFactor(params);
 
