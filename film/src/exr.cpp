@@ -22,7 +22,6 @@
 #include <cstring>
 #include <exception>
 #include <memory>
-#include <half.h>
 
 namespace hairvox {
 
@@ -40,7 +39,7 @@ struct ExrChannel {
     std::string name;
     const float* first; ///< pixel (0, 0)
     std::size_t stride; ///< floats between pixels (1 or 3)
-    bool half = true;
+    bool half;          ///< stored as half (else float)
 };
 
 class ExrLayout {
@@ -49,23 +48,19 @@ public:
         : width_(std::size_t(film.width()))
         , pixels_(film.pixelCount()) {
         static constexpr const char* rgb[3] = {"R", "G", "B"};
-        std::vector<bool> fullPrecision;
         for (const FilmLayer& l : film.layers()) {
             if (l.channels == 1) {
-                channels_.push_back({l.name, l.data.data(), 1});
-                fullPrecision.push_back(l.fullPrecision);
+                channels_.push_back({l.name, l.data.data(), 1, !l.fullPrecision});
                 continue;
             }
-            for (int c = 0; c < 3; ++c) {
-                channels_.push_back(
-                    {l.name.empty() ? rgb[c] : l.name + "." + rgb[c], l.data.data() + c, 3});
-                fullPrecision.push_back(l.fullPrecision);
-            }
+            for (int c = 0; c < 3; ++c)
+                channels_.push_back({l.name.empty() ? rgb[c] : l.name + "." + rgb[c],
+                                     l.data.data() + c, 3, !l.fullPrecision});
         }
         // Half unless the layer asks for float or a value does not fit.
         tbb::parallel_for(std::size_t(0), channels_.size(), [&](std::size_t i) {
             ExrChannel& c = channels_[i];
-            c.half = !fullPrecision[i] && detail::maxAbs(c.first, c.stride, pixels_) <= kHalfMax;
+            c.half = c.half && detail::maxAbs(c.first, c.stride, pixels_) <= kHalfMax;
         });
     }
 

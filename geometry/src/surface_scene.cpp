@@ -173,14 +173,32 @@ std::optional<SurfaceHit> SurfaceScene::intersect(const Vec3f& origin, const Vec
     return best;
 }
 
-bool SurfaceScene::occluded(const Vec3f& origin, const Vec3f& dir, float tMax) const {
-    if (empty() || !segmentMeetsBox(bounds_, origin, dir, tMax))
-        return false;
-    for (const Sphere& s : spheres_)
+namespace {
+
+/// A shadow segment's answer short of the meshes: Open (it misses the
+/// surfaces' bounds, or there are no meshes left to ask), Blocked (by a
+/// sphere), or AskMeshes.
+enum class Occlusion { Open, Blocked, AskMeshes };
+
+Occlusion occlusionBeforeMeshes(const Bounds3f& bounds, std::span<const Sphere> spheres,
+                                bool meshes, const Vec3f& origin, const Vec3f& dir, float tMax) {
+    if (!segmentMeetsBox(bounds, origin, dir, tMax))
+        return Occlusion::Open;
+    for (const Sphere& s : spheres)
         if (s.intersects(origin, dir, tMax))
-            return true;
-    if (!embree_)
+            return Occlusion::Blocked;
+    return meshes ? Occlusion::AskMeshes : Occlusion::Open;
+}
+
+} // namespace
+
+bool SurfaceScene::occluded(const Vec3f& origin, const Vec3f& dir, float tMax) const {
+    if (empty())
         return false;
+    if (const Occlusion o =
+            occlusionBeforeMeshes(bounds_, spheres_, embree_ != nullptr, origin, dir, tMax);
+        o != Occlusion::AskMeshes)
+        return o == Occlusion::Blocked;
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     RTCRay ray = makeRay(origin, dir, tMax);
@@ -194,18 +212,14 @@ void SurfaceScene::occluded(std::span<const Vec3f> origins, std::span<const Vec3
     std::vector<RTCRay> rays;
     std::vector<std::uint32_t> rayOf;
     for (std::size_t i = 0; i < origins.size(); ++i) {
-        blocked[i] = 0;
-        if (empty() || !segmentMeetsBox(bounds_, origins[i], dirs[i], tMax[i]))
-            continue;
-        for (const Sphere& s : spheres_)
-            if (s.intersects(origins[i], dirs[i], tMax[i])) {
-                blocked[i] = 1;
-                break;
-            }
-        if (blocked[i] || !embree_)
-            continue;
-        rays.push_back(makeRay(origins[i], dirs[i], tMax[i]));
-        rayOf.push_back(static_cast<std::uint32_t>(i));
+        const Occlusion o = empty() ? Occlusion::Open
+                                    : occlusionBeforeMeshes(bounds_, spheres_, embree_ != nullptr,
+                                                            origins[i], dirs[i], tMax[i]);
+        blocked[i] = o == Occlusion::Blocked ? 1 : 0;
+        if (o == Occlusion::AskMeshes) {
+            rays.push_back(makeRay(origins[i], dirs[i], tMax[i]));
+            rayOf.push_back(static_cast<std::uint32_t>(i));
+        }
     }
     if (rays.empty())
         return;

@@ -140,7 +140,6 @@ struct RenderContext {
             0.5f * ribbonWidthAt(groom, settings.fiberScale, k),
             0.5f * ribbonWidthAt(groom, settings.fiberScale, k + 1), camera.nearClip());
     }
-
 };
 
 /// Per tile, the depth behind which surfaces hide everything: the farthest

@@ -46,13 +46,17 @@ detail::ShadeKernelParams kernelParams(const DualScatteringShader& shader) {
             shader.params().d_b};
 }
 
+/// The kernel's global-term rows of one point (detail::kV ... kSigma2B).
+std::array<float, detail::kGlobalTermRows> globalTermRows(const GlobalTerm& g) {
+    return {g.V, g.T_s.r, g.T_s.g, g.T_s.b, g.sigma2_f.r, g.sigma2_f.g, g.sigma2_f.b};
+}
+
 /// The shader at one point given by its angles: ShadeResult's 15 floats,
 /// then f_s^scatter(σ_f²) and f_back(σ_f²).
 std::array<float, detail::kShadeRows + detail::kShadeTermRows>
 shadeOneAngle(const DualScatteringShader& shader, const FiberAngles& a, const GlobalTerm& g) {
     const auto angles = std::bit_cast<std::array<float, detail::kAngleRows>>(a);
-    const std::array<float, detail::kGlobalTermRows> term{
-        g.V, g.T_s.r, g.T_s.g, g.T_s.b, g.sigma2_f.r, g.sigma2_f.g, g.sigma2_f.b};
+    const auto term = globalTermRows(g);
     std::array<float, detail::kShadeRows + detail::kShadeTermRows> out;
     detail::shadeAngle(kernelParams(shader), angles.data(), term.data(), out.data());
     return out;
@@ -66,11 +70,9 @@ ShadeResult shadeResultOf(std::span<const float> v) {
     return {rgbAt(v, 0), rgbAt(v, 3), rgbAt(v, 6), rgbAt(v, 9), rgbAt(v, 12)};
 }
 
-} // namespace
-
-namespace {
 constexpr std::size_t kGlobalTermRow = detail::kDirectionRows;
 constexpr std::size_t kIrradianceRow = kGlobalTermRow + detail::kGlobalTermRows;
+
 } // namespace
 
 void ShadeBatch::reset(std::size_t count) {
@@ -115,12 +117,9 @@ void ShadeBatch::setIncident(const Vec3f& wi, const Rgb& E) {
 }
 
 void ShadeBatch::setGlobalTerm(std::size_t i, const GlobalTerm& g) {
-    in(kGlobalTermRow + detail::kV, i) = g.V;
-    for (int c = 0; c < 3; ++c) {
-        const auto uc = static_cast<std::size_t>(c);
-        in(kGlobalTermRow + detail::kTsR + uc, i) = g.T_s[c];
-        in(kGlobalTermRow + detail::kSigma2R + uc, i) = g.sigma2_f[c];
-    }
+    const auto rows = globalTermRows(g);
+    for (std::size_t r = 0; r < rows.size(); ++r)
+        in(kGlobalTermRow + r, i) = rows[r];
 }
 
 ShadeResult ShadeBatch::radiance(std::size_t i) const {
@@ -144,8 +143,7 @@ ShadeResult DualScatteringShader::shade(const Vec3f& wi, const Vec3f& wo, const 
                                         const GlobalTerm& g) const {
     const std::array<float, detail::kDirectionRows> directions{wi.x, wi.y, wi.z, wo.x, wo.y,
                                                                wo.z, u.x,  u.y,  u.z};
-    const std::array<float, detail::kGlobalTermRows> term{
-        g.V, g.T_s.r, g.T_s.g, g.T_s.b, g.sigma2_f.r, g.sigma2_f.g, g.sigma2_f.b};
+    const auto term = globalTermRows(g);
     const std::array<float, 3> irradiance{1.0f, 1.0f, 1.0f};
     std::array<float, detail::kShadeRows> radiance{};
     detail::shadeDirection(kernelParams(*this), directions.data(), term.data(), irradiance.data(),

@@ -381,8 +381,8 @@ MarschnerView marschnerView(const MarschnerBcsdf& bcsdf) {
     for (std::size_t p = 0; p < 3; ++p) {
         v.alpha[p] = bcsdf.alpha_[p];
         v.variance[p] = bcsdf.beta_[p] * bcsdf.beta_[p];
-        v.scale[p] = std::sqrt(1.0f / (static_cast<float>(8.0 * Pi) * v.variance[p]));
-        v.invTwoVariance[p] = 0.5f / v.variance[p];
+        v.scale[p] = bcsdf.M_[p].scale();
+        v.invTwoVariance[p] = bcsdf.M_[p].invTwoVariance();
     }
     const MarschnerBcsdf::AzimuthalTable& t = *bcsdf.table_;
     v.N = {t.rtt.data(), t.trt.data(), t.thetaCount, t.phiCount, t.eccCount, t.phiScale};

@@ -146,9 +146,8 @@ TEST(AlongFibers, PointsOffTheFibersAreEvaluatedAsTheyAre) {
         EXPECT_EQ(bitsOf(out[i].n), bitsOf(g.n)) << "query " << i;
     }
     // Spacing 0 is no sampling at all.
-    EXPECT_EQ(dynamic_cast<const FieldGlobalTerm*>(
-                  alongFibers(std::make_unique<FieldGlobalTerm>(), f.groom, 0.0f).get()) != nullptr,
-              true);
+    const auto unsampled = alongFibers(std::make_unique<FieldGlobalTerm>(), f.groom, 0.0f);
+    EXPECT_NE(dynamic_cast<const FieldGlobalTerm*>(unsampled.get()), nullptr);
 }
 
 TEST(AlongFibers, GridSampledAVoxelApartMatchesEveryPoint) {

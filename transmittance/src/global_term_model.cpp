@@ -1,6 +1,7 @@
 #include <hairvox/core/error.h>
 #include <hairvox/transmittance/global_term_model.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -53,24 +54,18 @@ public:
             tMax[i] = path.distance;
         }
         surfaces_->occluded(origins, dirs, tMax, occluded);
-        std::vector<std::uint32_t> blocked;
-        for (std::size_t i = 0; i < queries.size(); ++i)
-            if (occluded[i])
-                blocked.push_back(static_cast<std::uint32_t>(i));
+        const auto blocked =
+            static_cast<std::size_t>(std::count(occluded.begin(), occluded.end(), 1));
         GlobalTermStats stats;
-        if (blocked.empty()) {
+        if (blocked == 0) {
             // The common batch: nothing to take out, nothing to copy.
             stats = inner_->evaluate(queries, out);
         } else {
             std::vector<GlobalTermQuery> open;
             std::vector<std::size_t> openIndex;
-            open.reserve(queries.size() - blocked.size());
-            openIndex.reserve(queries.size() - blocked.size());
-            std::size_t next = 0;
             for (std::size_t i = 0; i < queries.size(); ++i) {
-                if (next < blocked.size() && blocked[next] == i) {
+                if (occluded[i]) {
                     out[i] = GlobalTerm::blocked();
-                    ++next;
                 } else {
                     open.push_back(queries[i]);
                     openIndex.push_back(i);
@@ -82,7 +77,7 @@ public:
                 out[openIndex[k]] = openOut[k];
         }
         stats.queries = queries.size();
-        stats.blockedBySurface += blocked.size();
+        stats.blockedBySurface += blocked;
         return stats;
     }
 

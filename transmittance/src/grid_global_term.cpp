@@ -206,9 +206,6 @@ BrickVolume GridModel::buildRates(const Light& light) const {
 
 class GridLightGlobalTerm final : public LightGlobalTerm {
 public:
-    /// Batches up to this size are evaluated on the calling thread.
-    static constexpr std::size_t kSerialQueries = 4096;
-
     GridLightGlobalTerm(const GridModel& model, const Light& light)
         : model_(model)
         , light_(light) {
@@ -229,20 +226,14 @@ public:
     GlobalTermStats evaluate(std::span<const GlobalTermQuery> queries,
                              std::span<GlobalTerm> out) const override {
         std::vector<unsigned char> empty(queries.size(), 0);
-        const auto evaluateRange = [&](const tbb::blocked_range<std::size_t>& range) {
-            for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                bool touched = false;
-                out[i] = evaluateOne(queries[i], touched);
-                empty[i] = touched ? 0 : 1;
-            }
-        };
-        // A renderer's batches (~1k points) come from threads that are busy
-        // already: spawning tasks for them costs more than it shares.
-        const tbb::blocked_range<std::size_t> all(0, queries.size(), 64);
-        if (queries.size() <= kSerialQueries)
-            evaluateRange(all);
-        else
-            tbb::parallel_for(all, evaluateRange);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, queries.size(), 64),
+                          [&](const tbb::blocked_range<std::size_t>& range) {
+                              for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                                  bool touched = false;
+                                  out[i] = evaluateOne(queries[i], touched);
+                                  empty[i] = touched ? 0 : 1;
+                              }
+                          });
         GlobalTermStats stats;
         stats.queries = stats.evaluated = queries.size();
         for (unsigned char e : empty)

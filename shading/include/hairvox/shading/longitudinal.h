@@ -9,10 +9,11 @@
 //  - Marschner's M_p (Eq. 4 of Marschner et al. 2003):    α = α_p,  σ² = β_p²
 //  - dual scattering's M^G_p (Sadeghi & Tamstorf Eq. 17): α = α_p,  σ² = β_p² + σ_f²
 //  - the back-scattering spread S̄_b (Zinke et al. Eq. 9): α = Δ̄_b,  σ² = σ̄_b² (+ σ_f²)
+// The renderer evaluates it across SIMD lanes in shading/src/shade_kernel-inl.h
+// (longitudinalLobe there: the same expression), the tables here.
 #pragma once
 
 #include <hairvox/core/math.h>
-#include <hairvox/core/rgb.h>
 
 #include <cmath>
 #include <concepts>
@@ -23,12 +24,6 @@ namespace hairvox {
 template <std::floating_point T>
 T longitudinalLobe(T x, T variance) {
     return std::sqrt(T(1) / (T(8.0 * Pi) * variance)) * std::exp(-x * x / (T(2) * variance));
-}
-
-/// Per channel, for RGB shifts and variances (the dual-scattering terms).
-inline Rgb longitudinalLobe(const Rgb& x, const Rgb& variance) {
-    return {longitudinalLobe(x.r, variance.r), longitudinalLobe(x.g, variance.g),
-            longitudinalLobe(x.b, variance.b)};
 }
 
 /// The same lobe with its shift and variance fixed and its constants
@@ -46,6 +41,10 @@ public:
         return scale_ * std::exp(-x * x * invTwoVariance_);
     }
     float shift() const { return shift_; }
+    /// The constants of scale·exp(−(θ_h − shift)²·invTwoVariance), for code
+    /// that evaluates the lobe elsewhere (the SIMD kernel).
+    float scale() const { return scale_; }
+    float invTwoVariance() const { return invTwoVariance_; }
 
 private:
     float shift_ = 0, invTwoVariance_ = 0, scale_ = 0;
