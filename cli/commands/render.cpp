@@ -36,7 +36,7 @@ struct RenderCommandOptions {
     std::optional<std::uint64_t> seed;
     bool continueRun = false;
     std::optional<std::uint32_t> width, height;
-    std::optional<float> voxelSize;
+    std::optional<float> voxelSize, shadingTolerance;
     std::optional<double> maxMemoryGiB;
     int threads = 0;
     bool quiet = false;
@@ -138,6 +138,12 @@ void runRender(const RenderCommandOptions& opt) {
         scene.integrator = *kIntegratorNames.parse(opt.integrator);
     if (!opt.shadingRate.empty())
         scene.shadingRate = *kShadingRateNames.parse(opt.shadingRate);
+    if (opt.shadingTolerance) {
+        if (scene.shadingRate != ShadingRate::Adaptive)
+            throw InputError("--shading-tolerance applies to the adaptive shading rate "
+                             "(--shading-rate adaptive)");
+        scene.shadingTolerance = *opt.shadingTolerance;
+    }
     if (!opt.exrCompression.empty())
         scene.output.exrCompression = *kExrCompressionNames.parse(opt.exrCompression);
     if ((opt.spp || opt.timeLimit || opt.seed || opt.continueRun) &&
@@ -198,9 +204,13 @@ void addRenderCommand(CLI::App& app) {
     cmd->add_option("--mode", opt->mode, "Global-term mode (dual scattering)")
         ->check(CLI::IsMember(kGlobalTermModeNames.names()));
     cmd->add_option("--shading-rate", opt->shadingRate,
-                    "Where the dual-scattering shader is evaluated: fragment or vertex "
-                    "(docs/scene.md)")
+                    "Where the dual-scattering shader is evaluated: fragment, vertex or "
+                    "adaptive (docs/scene.md)")
         ->check(CLI::IsMember(kShadingRateNames.names()));
+    cmd->add_option("--shading-tolerance", opt->shadingTolerance,
+                    "Adaptive rate: a segment is interpolated when its midpoint is within this "
+                    "fraction of its mean radiance from the ends' interpolation [0, 1]")
+        ->check(CLI::Range(0.0f, 1.0f));
     cmd->add_option("--exr-compression", opt->exrCompression,
                     "EXR compression: rle (default), zips, zip or none; overrides the scene's "
                     "(sizes and times in docs/scene.md)")

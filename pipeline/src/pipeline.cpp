@@ -211,6 +211,7 @@ RasterSettings rasterSettings(const Scene& scene, const PipelineOptions& options
     RasterSettings s;
     s.fiberScale = scene.fiberScale;
     s.shadingRate = scene.shadingRate;
+    s.shadingTolerance = scene.shadingTolerance;
     s.background = scene.background;
     s.threads = options.threads;
     s.progress = options.progress;
@@ -710,10 +711,19 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
             " segments outside the view, " + thousands(st.segmentTilesBehindSurfaces) +
             " segment-tiles behind surfaces, " + thousands(st.segmentTilesSkipped) +
             " segment-tiles opaque");
+    const std::string rate =
+        scene.shadingRate == ShadingRate::Adaptive
+            ? strCat("adaptive rate, tolerance ", scene.shadingTolerance, ": ",
+                     thousands(st.smoothSegments), " of ", thousands(st.probedSegments),
+                     " probed segment-tiles smooth")
+            : strCat(toString(scene.shadingRate), " rate");
     row("shade", r.times.shade,
-        strCat(thousands(st.shadingPoints), " shading points (", toString(scene.shadingRate),
-               " rate); skipped ", thousands(st.fragmentsBehindOpaque),
-               " fragments behind opaque pixels"));
+        strCat(thousands(st.shadingPoints), " shading points (", rate, "); skipped ",
+               thousands(st.fragmentsBehindOpaque), " fragments behind opaque pixels",
+               st.fragmentsInterpolated > 0
+                   ? strCat(", ", thousands(st.fragmentsInterpolated),
+                            " visible fragments interpolated instead of shaded")
+                   : std::string()));
     row("write", r.times.write, written.empty() ? "nothing" : written);
 }
 

@@ -30,6 +30,7 @@ constexpr Range kFiberSampleSpacing{0.0, 4.0};
 constexpr std::uint64_t kMaxExactRays = 65536;
 constexpr Range kExactRadius{0.0, 1000.0};
 constexpr Range kBackground{0.0, 1e6};
+constexpr Range kShadingTolerance{0.0, 1.0};
 constexpr Range kExposure{-20.0, 20.0};
 constexpr Range kTimeLimit{0.0, 1e7};
 constexpr Range kDegrees{-360.0, 360.0};
@@ -417,6 +418,7 @@ void Scene::validate() const {
                                 ": expected an integer in [1, ", kMaxExactRays, "]"));
     requireInRange("global_term.exact.radius", exact.radius, kExactRadius);
     requireInRange("background", background, kBackground);
+    requireInRange("shading_tolerance", shadingTolerance, kShadingTolerance);
     try {
         pathTrace.validate();
     } catch (const InputError& e) {
@@ -520,6 +522,11 @@ Scene parseScene(const nlohmann::json& document, const std::string& sourceName,
     }
     if (const JsonValue v = root["shading_rate"]; v.present())
         scene.shadingRate = v.oneOf(kShadingRateNames);
+    if (const JsonValue v = root["shading_tolerance"]; v.present()) {
+        if (scene.shadingRate != ShadingRate::Adaptive)
+            v.fail("applies to the adaptive shading rate only (\"shading_rate\": \"adaptive\")");
+        scene.shadingTolerance = v.numberF(kShadingTolerance);
+    }
     if (const JsonValue v = root["background"]; v.present())
         scene.background = v.rgb(kBackground);
 
@@ -594,7 +601,7 @@ std::ostream& operator<<(std::ostream& os, const Scene& s) {
     }
     os << ", mode=" << s.globalTermMode
        << ", voxel=" << (s.voxelSize ? strCat(*s.voxelSize) : std::string("auto"))
-       << ", exact(rays=" << s.exact.rays << ", r=" << s.exact.radius << "), rate=" << s.shadingRate
+       << ", exact(rays=" << s.exact.rays << ", r=" << s.exact.radius << "), rate=" << s.shadingRate << " (tolerance " << s.shadingTolerance << ")"
        << ", background=" << s.background << ", exr='" << s.output.exr.string() << "', png='"
        << s.output.png.string() << "', exposure=" << s.output.exposure
        << ", tone_map=" << toString(s.output.toneMap) << ")";

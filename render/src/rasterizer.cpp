@@ -328,6 +328,9 @@ struct TileScratch {
     std::vector<ShadingPoint> points;
     std::vector<float> results;  ///< per point of a batch: stride floats
     std::vector<float> lerped;   ///< one interpolated vertex-rate result
+    std::vector<std::uint32_t> probed;   ///< adaptive rate: local segments shaded at t = 0, ½, 1
+    std::vector<float> probeResults;     ///< per probed segment: 3 × stride floats
+    std::vector<std::uint32_t> probeOf;  ///< per local segment: its smooth probe, or none
     std::vector<float> pixelSum; ///< per pixel: stride floats of weighted sums
 };
 
@@ -335,6 +338,7 @@ struct TileResult {
     double rasterSeconds = 0, shadeSeconds = 0;
     std::uint64_t fragments = 0, behindOpaque = 0, composited = 0, shadingPoints = 0, invalid = 0;
     std::uint64_t segmentsSkipped = 0;
+    std::uint64_t probedSegments = 0, smoothSegments = 0, interpolated = 0;
     std::vector<std::string> warnings;
 };
 
@@ -351,6 +355,27 @@ bool isValid(std::span<const float> r, std::size_t radianceFloats) {
     for (std::size_t i = radianceFloats; i < r.size(); ++i)
         bad |= std::uint32_t((std::bit_cast<std::uint32_t>(r[i]) & 0x7f800000u) == 0x7f800000u);
     return bad == 0;
+}
+
+/// Adaptive rate: a segment is probed at this many points (t = 0, ½, 1) when
+/// it has more visible fragments than that in a tile.
+constexpr std::size_t kProbePoints = 3;
+
+/// Adaptive rate: whether a segment's shading is smooth enough to interpolate,
+/// from its results a, m, b at t = 0, ½, 1 (radiance floats, ≥ 0): the
+/// midpoint's distance from the ends' interpolation against the segment's
+/// mean radiance,
+///     Σ_k |m_k − (a_k + b_k)/2|  ≤  τ · Σ_k (a_k + m_k + b_k)/3,
+/// summed over every radiance float (each layer, each channel), so that no
+/// lobe's error hides behind another's.
+bool smoothAlong(const float* a, const float* m, const float* b, std::size_t radianceFloats,
+                 float tolerance) {
+    float error = 0, mean = 0;
+    for (std::size_t k = 0; k < radianceFloats; ++k) {
+        error += std::abs(m[k] - 0.5f * (a[k] + b[k]));
+        mean += (a[k] + m[k] + b[k]) * (1.0f / 3.0f);
+    }
+    return error <= tolerance * mean;
 }
 
 /// Renders one tile.
@@ -393,10 +418,11 @@ public:
         rasterizeAndComposite();
         finishCoverage();
         const Clock::time_point shadeStart = Clock::now();
-        if (ctx_.settings.shadingRate == ShadingRate::Fragment)
-            shadeFragments();
-        else
-            shadeVertices();
+        switch (ctx_.settings.shadingRate) {
+        case ShadingRate::Fragment: shadeFragments(); break;
+        case ShadingRate::Vertex: shadeVertices(); break;
+        case ShadingRate::Adaptive: shadeAdaptive(); break;
+        }
         finishShading();
         result_.shadeSeconds = secondsSince(shadeStart);
         result_.rasterSeconds = secondsSince(start) - result_.shadeSeconds;
@@ -654,7 +680,8 @@ private:
                       y0_ + int(pixel / std::uint32_t(width_)), ")");
     }
 
-    /// Orders the visible fragments by segment (a stable counting sort):
+    /// Orders the visible fragments by segment (a stable counting sort;
+    /// segment i's are then [segmentStart[i], segmentStart[i + 1])):
     /// the points of a batch then come segment by segment, which lets a
     /// shader share work along a segment (the global term's fiber samples,
     /// transmittance/alongFibers()) and the segment's data between points.
@@ -665,8 +692,9 @@ private:
         for (std::size_t i = 0; i < bins_.size(); ++i)
             s_.segmentStart[i + 1] += s_.segmentStart[i];
         s_.grouped.resize(s_.visible.size());
+        s_.cursor.assign(s_.segmentStart.begin(), s_.segmentStart.end() - 1);
         for (const Visible& v : s_.visible)
-            s_.grouped[s_.segmentStart[v.local]++] = v;
+            s_.grouped[s_.cursor[v.local]++] = v;
         s_.visible.swap(s_.grouped);
     }
 
@@ -722,14 +750,96 @@ private:
                         s_.vertexResults.begin() + std::ptrdiff_t(begin * stride_));
         }
         s_.lerped.resize(stride_);
+        result_.interpolated += s_.visible.size();
         for (const Visible& v : s_.visible) {
             const float* a =
                 s_.vertexResults.data() + std::size_t(s_.vertexSlot[v.local]) * stride_;
-            const float* b = a + stride_;
-            for (std::size_t k = 0; k < stride_; ++k)
-                s_.lerped[k] = hairvox::lerp(v.t, a[k], b[k]);
+            lerpResult(v.t, a, a + stride_);
             accumulate(v, s_.lerped.data());
         }
+    }
+
+    /// Adaptive rate: the error of interpolating a segment is measured on
+    /// the segment before its fragments are shaded. A segment with more than
+    /// kProbePoints visible fragments in the tile is shaded at t = 0, ½ and 1;
+    /// when the midpoint's radiance is within the tolerance of the ends'
+    /// linear interpolation (smoothAlong()), the fragments interpolate the
+    /// three results piecewise linearly, and otherwise each is shaded. The
+    /// decision depends on the segment alone, so tiles sharing a segment agree.
+    void shadeAdaptive() {
+        s_.pixelSum.assign(std::size_t(area_) * stride_, 0.0f);
+        groupVisibleBySegment();
+        auto fragmentsOf = [&](std::size_t i) {
+            return s_.segmentStart[i + 1] - s_.segmentStart[i];
+        };
+        s_.probed.clear();
+        for (std::size_t i = 0; i < bins_.size(); ++i)
+            if (fragmentsOf(i) > kProbePoints)
+                s_.probed.push_back(static_cast<std::uint32_t>(i));
+        const std::size_t probePoints = kProbePoints * s_.probed.size();
+        s_.probeResults.resize(probePoints * stride_);
+        for (std::size_t begin = 0; begin < probePoints; begin += kShadeBatch) {
+            const std::size_t count = std::min(kShadeBatch, probePoints - begin);
+            s_.points.resize(count);
+            for (std::size_t i = 0; i < count; ++i) {
+                const std::size_t j = begin + i;
+                s_.points[i] = pointOnSegment(s_.probed[j / kProbePoints],
+                                              0.5f * float(j % kProbePoints));
+            }
+            shadeBatch(count, [&](std::size_t) { return std::string("probing a segment"); });
+            std::copy_n(s_.results.begin(), count * stride_,
+                        s_.probeResults.begin() + std::ptrdiff_t(begin * stride_));
+        }
+
+        constexpr std::uint32_t none = std::numeric_limits<std::uint32_t>::max();
+        s_.probeOf.assign(bins_.size(), none);
+        for (std::size_t p = 0; p < s_.probed.size(); ++p) {
+            const float* a = s_.probeResults.data() + kProbePoints * p * stride_;
+            if (smoothAlong(a, a + stride_, a + 2 * stride_, ctx_.radianceFloats,
+                            ctx_.settings.shadingTolerance)) {
+                s_.probeOf[s_.probed[p]] = static_cast<std::uint32_t>(p);
+                ++result_.smoothSegments;
+                result_.interpolated += fragmentsOf(s_.probed[p]);
+            }
+        }
+        result_.probedSegments += s_.probed.size();
+
+        // The fragments of the other segments, shaded in segment order.
+        s_.grouped.clear();
+        s_.lerped.resize(stride_);
+        for (const Visible& v : s_.visible) {
+            const std::uint32_t p = s_.probeOf[v.local];
+            if (p == none) {
+                s_.grouped.push_back(v);
+                continue;
+            }
+            const float* a = s_.probeResults.data() + kProbePoints * p * stride_;
+            const float* m = a + stride_;
+            const float u = 2.0f * v.t;
+            if (u > 1.0f)
+                lerpResult(u - 1.0f, m, m + stride_);
+            else
+                lerpResult(u, a, m);
+            accumulate(v, s_.lerped.data());
+        }
+        for (std::size_t begin = 0; begin < s_.grouped.size(); begin += kShadeBatch) {
+            const std::size_t count = std::min(kShadeBatch, s_.grouped.size() - begin);
+            s_.points.resize(count);
+            for (std::size_t i = 0; i < count; ++i) {
+                const Visible& v = s_.grouped[begin + i];
+                s_.points[i] = pointOnSegment(v.local, v.t);
+            }
+            shadeBatch(count,
+                       [&](std::size_t i) { return pixelName(s_.grouped[begin + i].pixel); });
+            for (std::size_t i = 0; i < count; ++i)
+                accumulate(s_.grouped[begin + i], s_.results.data() + i * stride_);
+        }
+    }
+
+    /// s_.lerped ← (1 − u)·a + u·b, one shader result.
+    void lerpResult(float u, const float* a, const float* b) {
+        for (std::size_t k = 0; k < stride_; ++k)
+            s_.lerped[k] = hairvox::lerp(u, a[k], b[k]);
     }
 
     /// Radiance layers get the premultiplied sums (and add to the beauty);
@@ -780,7 +890,9 @@ std::ostream& operator<<(std::ostream& os, const RasterStats& s) {
               << s.segmentTileRefs << " segment-tile pairs, " << s.segmentTilesBehindSurfaces
               << " behind surfaces; " << s.fragments << " fragments, " << s.fragmentsComposited
               << " composited, " << s.fragmentsBehindOpaque << " behind opaque pixels; "
-              << s.shadingPoints << " shading points, " << s.invalidSamples << " rejected; "
+              << s.shadingPoints << " shading points, " << s.fragmentsInterpolated
+              << " fragments interpolated, " << s.smoothSegments << " of " << s.probedSegments
+              << " probed segments smooth, " << s.invalidSamples << " rejected; "
               << s.tiles << " tiles)";
 }
 
@@ -791,6 +903,9 @@ RasterOutput rasterize(const Groom& groom, const Camera& camera, const FragmentS
     if (!(settings.opaqueTransmittance >= 0.0f && settings.opaqueTransmittance < 1.0f))
         throw InputError(strCat("opaque transmittance ", settings.opaqueTransmittance,
                                 ": expected a number in [0, 1)"));
+    if (!(settings.shadingTolerance >= 0.0f && settings.shadingTolerance <= 1.0f))
+        throw InputError(strCat("shading tolerance ", settings.shadingTolerance,
+                                ": expected a number in [0, 1]"));
     if (!settings.background.isFinite() || settings.background.minComponent() < 0)
         throw InputError(
             strCat("background ", settings.background, ": expected finite values >= 0"));
@@ -856,6 +971,9 @@ RasterOutput rasterize(const Groom& groom, const Camera& camera, const FragmentS
         st.segmentTilesSkipped += r.segmentsSkipped;
         st.fragmentsComposited += r.composited;
         st.shadingPoints += r.shadingPoints;
+        st.probedSegments += r.probedSegments;
+        st.smoothSegments += r.smoothSegments;
+        st.fragmentsInterpolated += r.interpolated;
         st.invalidSamples += r.invalid;
         for (std::string& w : r.warnings)
             if (out.warnings.size() < kMaxWarnings)

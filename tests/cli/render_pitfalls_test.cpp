@@ -192,6 +192,15 @@ TEST(CliRenderOptions, ShadingRateIsChosenOnTheCommandLine) {
     r = test::runHairvox("render " + quoted(file) + " --shading-rate pixel");
     EXPECT_NE(r.exitCode, 0);
     EXPECT_TRUE(contains(r.output, "--shading-rate")) << r.output;
+    // The adaptive rate's report says what it interpolated instead of shading.
+    r = test::runHairvox("render " + quoted(file) +
+                         " --shading-rate adaptive --shading-tolerance 0.1");
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_TRUE(contains(r.output, "(adaptive rate, tolerance 0.1: ")) << r.output;
+    EXPECT_TRUE(contains(r.output, "probed segment-tiles smooth")) << r.output;
+    r = test::runHairvox("render " + quoted(file) + " --shading-tolerance 0.1");
+    EXPECT_NE(r.exitCode, 0);
+    EXPECT_TRUE(contains(r.output, "--shading-tolerance applies to the adaptive")) << r.output;
 }
 
 TEST(CliRenderOptions, ExrCompressionIsChosenOnTheCommandLine) {

@@ -116,6 +116,22 @@ TEST(Scene, EveryFeatureParses) {
     }
 }
 
+TEST(Scene, ShadingToleranceBelongsToTheAdaptiveRate) {
+    nlohmann::json j = validScene();
+    j["shading_rate"] = "adaptive";
+    j["shading_tolerance"] = 0.1;
+    const Scene s = parseScene(j, "scene.json", "/");
+    EXPECT_EQ(s.shadingRate, ShadingRate::Adaptive);
+    EXPECT_FLOAT_EQ(s.shadingTolerance, 0.1f);
+    j["shading_tolerance"] = 2;
+    EXPECT_NE(errorOf(j).find("/shading_tolerance"), std::string::npos) << errorOf(j);
+    j["shading_tolerance"] = "0.1";
+    EXPECT_NE(errorOf(j).find("/shading_tolerance"), std::string::npos) << errorOf(j);
+    j["shading_rate"] = "fragment";
+    j["shading_tolerance"] = 0.1;
+    EXPECT_NE(errorOf(j).find("adaptive shading rate only"), std::string::npos) << errorOf(j);
+}
+
 TEST(Scene, DirectionalLightPointsTowardTheLightAndIsNormalised) {
     nlohmann::json j = validScene();
     j["lights"][0]["direction"] = {0, 0, 2};

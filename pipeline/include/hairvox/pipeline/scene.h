@@ -124,6 +124,7 @@ struct Scene {
     GlobalTermMode globalTermMode = GlobalTermMode::Grid;
     ExactSettings exact;
     ShadingRate shadingRate = ShadingRate::Fragment;
+    float shadingTolerance = kDefaultShadingTolerance; ///< the adaptive rate's τ, [0, 1]
     Rgb background{0.0f}; ///< radiance behind everything, each channel in [0, 1e6]
     OutputSettings output;
 

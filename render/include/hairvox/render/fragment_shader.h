@@ -18,9 +18,17 @@
 //    nearest to the pixel centre (in screen space, perspective-correct);
 //  - vertex:   the strand vertices of every segment with a visible fragment in
 //    a tile are shaded once per tile, and each fragment interpolates its
-//    segment's two vertex results linearly in the segment parameter.
-// In both modes the shading tangent is the vertex tangents interpolated along
-// the segment, so the two differ only in where the shader is evaluated.
+//    segment's two vertex results linearly in the segment parameter;
+//  - adaptive: the rate is chosen per segment by the error interpolation
+//    would make there, measured before the fragments are shaded. A segment
+//    with more than three visible fragments in a tile is shaded at t = 0, ½, 1;
+//    if the midpoint's radiance is within a tolerance τ of the ends' linear
+//    interpolation (relative to the segment's mean radiance, summed over every
+//    radiance layer), its fragments interpolate the three results piecewise
+//    linearly — where the global term, the shadows and the highlights vary
+//    slowly along the fiber — and otherwise each fragment is shaded.
+// In every mode the shading tangent is the vertex tangents interpolated along
+// the segment, so the modes differ only in where the shader is evaluated.
 #pragma once
 
 #include <hairvox/core/enum_names.h>
@@ -34,12 +42,16 @@
 
 namespace hairvox {
 
-enum class ShadingRate { Fragment, Vertex };
+enum class ShadingRate { Fragment, Vertex, Adaptive };
 
-inline constexpr EnumNames<ShadingRate, 2> kShadingRateNames{{{
+inline constexpr EnumNames<ShadingRate, 3> kShadingRateNames{{{
     {ShadingRate::Fragment, "fragment"},
     {ShadingRate::Vertex, "vertex"},
+    {ShadingRate::Adaptive, "adaptive"},
 }}};
+
+/// The adaptive rate's τ by default (docs/scene.md: image error and savings).
+inline constexpr float kDefaultShadingTolerance = 0.05f;
 inline const char* toString(ShadingRate rate) {
     return kShadingRateNames.name(rate);
 }

@@ -74,6 +74,10 @@ struct SurfaceLayer {
 struct RasterSettings {
     FiberScale fiberScale; ///< ribbons k·D (k·D_i) wide: a strand's coverage counts k hairs
     ShadingRate shadingRate = ShadingRate::Fragment;
+    /// Adaptive rate: a segment's fragments interpolate three shaded points
+    /// when the midpoint's radiance is within this fraction of the segment's
+    /// mean radiance from the ends' interpolation (fragment_shader.h). [0, 1]
+    float shadingTolerance = kDefaultShadingTolerance;
     Rgb background{0.0f}; ///< radiance behind everything
     /// A pixel is opaque once its transmittance is ≤ this: fragments behind it
     /// are skipped. Their share of the pixel is at most this value. [0, 1)
@@ -100,6 +104,10 @@ struct RasterStats {
     std::uint64_t fragmentsBehindOpaque = 0;
     std::uint64_t fragmentsComposited = 0; ///< hair fragments that reached the pixel
     std::uint64_t shadingPoints = 0;       ///< points handed to the shader
+    /// Adaptive rate: (segment, tile) pairs probed at t = 0, ½, 1, those found
+    /// smooth, and the hair fragments that interpolated them instead of being
+    /// shaded.
+    std::uint64_t probedSegments = 0, smoothSegments = 0, fragmentsInterpolated = 0;
     std::uint64_t invalidSamples = 0;      ///< shader results rejected (NaN, Inf, negative)
     std::uint64_t tiles = 0;
 };
