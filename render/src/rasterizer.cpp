@@ -765,7 +765,8 @@ private:
     /// when the midpoint's radiance is within the tolerance of the ends'
     /// linear interpolation (smoothAlong()), the fragments interpolate the
     /// three results piecewise linearly, and otherwise each is shaded. The
-    /// decision depends on the segment alone, so tiles sharing a segment agree.
+    /// probe's verdict depends on the segment alone, whether it is probed on
+    /// the tile's fragments: neither on the threads.
     void shadeAdaptive() {
         s_.pixelSum.assign(std::size_t(area_) * stride_, 0.0f);
         groupVisibleBySegment();
