@@ -7,8 +7,14 @@
 
 #include <gtest/gtest.h>
 
+#include <poll.h>
+#include <sys/inotify.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <array>
 #include <chrono>
+#include <cstring>
 #include <filesystem>
 #include <string>
 #include <thread>
@@ -79,6 +85,47 @@ bool waitFor(Child& child, Ready ready, double timeoutSeconds) {
         std::this_thread::sleep_for(std::chrono::microseconds(200));
     }
     return false;
+}
+
+/// Waits until a temporary of `finalName` is created in `dir` or the child
+/// ends; true if the temporary came first. Polling the directory misses a
+/// write that is over in less than the poll interval (a small PNG is), so this
+/// waits on inotify's creation event instead: it arrives when the file is
+/// created, before its bytes are written, fsync'ed and renamed.
+inline bool waitForTemporaryOf(Child& child, const std::filesystem::path& dir,
+                               const std::string& finalName, double timeoutSeconds) {
+    const int fd = ::inotify_init1(IN_NONBLOCK | IN_CLOEXEC);
+    if (fd < 0 || ::inotify_add_watch(fd, dir.c_str(), IN_CREATE) < 0) {
+        ADD_FAILURE() << "inotify on " << dir << ": " << std::strerror(errno);
+        if (fd >= 0)
+            ::close(fd);
+        return false;
+    }
+    const std::string prefix = "." + finalName + ".tmp-";
+    bool created = hasTemporaryOf(dir, finalName);
+    const auto deadline = Clock::now() + std::chrono::duration<double>(timeoutSeconds);
+    alignas(inotify_event) std::array<char, 4096> buffer{};
+    while (!created && Clock::now() < deadline) {
+        pollfd p{fd, POLLIN, 0};
+        if (::poll(&p, 1, 1) > 0) {
+            const ssize_t n = ::read(fd, buffer.data(), buffer.size());
+            for (ssize_t at = 0; at < n;) {
+                inotify_event event{};
+                std::memcpy(&event, buffer.data() + at, sizeof event);
+                const char* name = buffer.data() + at + sizeof(inotify_event);
+                if (event.len > 0 && std::string(name).rfind(prefix, 0) == 0)
+                    created = true;
+                at += static_cast<ssize_t>(sizeof(inotify_event) + event.len);
+            }
+            continue;
+        }
+        siginfo_t info{};
+        if (::waitid(P_PID, static_cast<id_t>(child.pid()), &info, WEXITED | WNOHANG | WNOWAIT) == 0 &&
+            info.si_pid == child.pid())
+            break; // ended (left for Child::poll() to reap)
+    }
+    ::close(fd);
+    return created;
 }
 
 } // namespace hairvox::test
