@@ -26,6 +26,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 MARKERS = {"exact": "o", "grid": "s", "approx": "^"}
+# Marker fill per shading rate: fragment solid, adaptive pale, vertex hollow.
+FILL = {"fragment": 1.0, "adaptive": 0.3, "vertex": 0.0}
 STAGES = [("total", "total_s"), ("voxelize", "voxelize_s"), ("global term", "global_term_s"),
           ("raster+shade", None)]
 
@@ -75,9 +77,10 @@ def plot_runtime_vs_error(rows, path):
             floors = []
             for r in (r for r in accuracy if r["scene"] == scene and number(r, key)):
                 t, e = number(r, "total_s"), number(r, key)
-                filled = r["shading_rate"] == "fragment"
+                fill = FILL.get(r["shading_rate"], 0.0)
+                face = matplotlib.colors.to_rgba(colour, fill) if fill > 0 else "none"
                 ax.scatter([t], [e], marker=MARKERS.get(r["mode"], "o"), s=42,
-                           facecolors=colour if filled else "none", edgecolors=colour, zorder=3)
+                           facecolors=face, edgecolors=colour, zorder=3)
                 ax.annotate(short_label(r), (t, e), textcoords="offset points", xytext=(4, 3),
                             fontsize=7, color=colour)
                 points.append((t, e))
@@ -102,7 +105,10 @@ def plot_runtime_vs_error(rows, path):
     first = axes[0].legend(loc="upper right", fontsize=8, title="scene (line: Pareto front)")
     axes[0].add_artist(first)
     axes[1].legend(handles=legend + [plt.Line2D([], [], ls="", marker="o", mfc="none",
-                                                color="gray", label="hollow: vertex shading")],
+                                                color="gray", label="hollow: vertex shading"),
+                                 plt.Line2D([], [], ls="", marker="o",
+                                            mfc=matplotlib.colors.to_rgba("gray", FILL["adaptive"]),
+                                            color="gray", label="pale: adaptive shading")],
                    loc="upper right", fontsize=8, title="eK: K rays; gS/aS: voxel S·h0")
     fig.tight_layout()
     fig.savefig(path)

@@ -149,11 +149,11 @@ TEST(BenchSweep, TinySweepWritesTablesAndPlots) {
     o.outDir = dir / "out";
     const SweepResult result = runSweep(o);
 
-    // 1 reference + 2 rates × (1 exact + 2 grid + 2 approx) + 2 melanins × (1
+    // 1 reference + 3 rates × (1 exact + 2 grid + 2 approx) + 2 melanins × (1
     // path reference + 2 modes) + 2 + 2 scaling rows.
-    ASSERT_EQ(result.rows.size(), 21u);
+    ASSERT_EQ(result.rows.size(), 26u);
     const auto csv = readCsv(o.outDir / "results.csv");
-    ASSERT_EQ(csv.size(), 22u);
+    ASSERT_EQ(csv.size(), 27u);
     ASSERT_EQ(csv[0].size(), kBenchCsvColumns.size());
     for (std::size_t i = 0; i < kBenchCsvColumns.size(); ++i)
         EXPECT_EQ(csv[0][i], kBenchCsvColumns[i]);

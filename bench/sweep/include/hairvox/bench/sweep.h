@@ -216,7 +216,8 @@ struct SweepOptions {
     std::vector<double> voxelScales;      ///< grid and approx voxel sizes, × h0
     std::vector<std::uint32_t> exactRays; ///< exact configurations: rays per point
     std::uint32_t referenceRays = 16;     ///< the image reference's rays per point, [1, 65536]
-    std::vector<ShadingRate> shadingRates{ShadingRate::Fragment, ShadingRate::Vertex};
+    std::vector<ShadingRate> shadingRates{ShadingRate::Fragment, ShadingRate::Vertex,
+                                          ShadingRate::Adaptive};
     std::size_t probePoints = 1000; ///< 0: no probe errors
     std::uint32_t probeRays = 256;
     std::uint64_t probeSeed = 1;
