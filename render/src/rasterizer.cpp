@@ -701,17 +701,21 @@ private:
     void shadeFragments() {
         s_.pixelSum.assign(std::size_t(area_) * stride_, 0.0f);
         groupVisibleBySegment();
-        for (std::size_t begin = 0; begin < s_.visible.size(); begin += kShadeBatch) {
-            const std::size_t count = std::min(kShadeBatch, s_.visible.size() - begin);
+        shadeEach(s_.visible);
+    }
+
+    /// Shades each fragment at its point, in batches, into its pixel's sums.
+    void shadeEach(std::span<const Visible> fragments) {
+        for (std::size_t begin = 0; begin < fragments.size(); begin += kShadeBatch) {
+            const std::size_t count = std::min(kShadeBatch, fragments.size() - begin);
             s_.points.resize(count);
             for (std::size_t i = 0; i < count; ++i) {
-                const Visible& v = s_.visible[begin + i];
+                const Visible& v = fragments[begin + i];
                 s_.points[i] = pointOnSegment(v.local, v.t);
             }
-            shadeBatch(count,
-                       [&](std::size_t i) { return pixelName(s_.visible[begin + i].pixel); });
+            shadeBatch(count, [&](std::size_t i) { return pixelName(fragments[begin + i].pixel); });
             for (std::size_t i = 0; i < count; ++i)
-                accumulate(s_.visible[begin + i], s_.results.data() + i * stride_);
+                accumulate(fragments[begin + i], s_.results.data() + i * stride_);
         }
     }
 
@@ -823,18 +827,7 @@ private:
                 lerpResult(u, a, m);
             accumulate(v, s_.lerped.data());
         }
-        for (std::size_t begin = 0; begin < s_.grouped.size(); begin += kShadeBatch) {
-            const std::size_t count = std::min(kShadeBatch, s_.grouped.size() - begin);
-            s_.points.resize(count);
-            for (std::size_t i = 0; i < count; ++i) {
-                const Visible& v = s_.grouped[begin + i];
-                s_.points[i] = pointOnSegment(v.local, v.t);
-            }
-            shadeBatch(count,
-                       [&](std::size_t i) { return pixelName(s_.grouped[begin + i].pixel); });
-            for (std::size_t i = 0; i < count; ++i)
-                accumulate(s_.grouped[begin + i], s_.results.data() + i * stride_);
-        }
+        shadeEach(s_.grouped);
     }
 
     /// s_.lerped ← (1 − u)·a + u·b, one shader result.
