@@ -12,6 +12,7 @@
 #include <memory>
 #include <new>
 #include <limits>
+#include <atomic>
 #include <span>
 
 namespace hairvox::detail {
@@ -48,6 +49,14 @@ inline void addSimpson(Lanes& a, const Lanes& f0, const Lanes& fm, const Lanes& 
         a.v[lane] += w * (f0.v[lane] + 4.0f * fm.v[lane] + f1.v[lane]);
 }
 
+/// Bit of cell c in a bitmap of the box [lo, hi] (x fastest).
+std::size_t boxBit(const glm::ivec3& c, const glm::ivec3& lo, const glm::ivec3& hi) {
+    const glm::ivec3 d = c - lo;
+    const glm::ivec3 n = hi - lo + 1;
+    return (std::size_t(d.z) * std::size_t(n.y) + std::size_t(d.y)) * std::size_t(n.x) +
+           std::size_t(d.x);
+}
+
 } // namespace
 
 const Lanes BrickVolume::kZero{};
@@ -58,7 +67,7 @@ BrickVolume::BrickVolume(double voxelSize)
     , slots_(64, -1) {}
 
 std::size_t BrickVolume::memoryBytes() const {
-    return valueCount_ * sizeof(Lanes) + slotIndex_.capacity() * sizeof(std::uint16_t) +
+    return valueCount_ * sizeof(Lanes) + present_.capacity() * sizeof(SlotBits) +
            valueBase_.capacity() * sizeof(std::size_t) +
            cellMask_.capacity() * sizeof(cellMask_[0]) +
            occupancy_.capacity() * sizeof(std::uint64_t) +
@@ -118,10 +127,7 @@ void BrickVolume::AlignedDelete::operator()(Lanes* p) const {
 }
 
 std::size_t BrickVolume::occupancyBit(const glm::ivec3& b) const {
-    const glm::ivec3 d = b - brickMin_;
-    const glm::ivec3 n = brickMax_ - brickMin_ + 1;
-    return (std::size_t(d.z) * std::size_t(n.y) + std::size_t(d.y)) * std::size_t(n.x) +
-           std::size_t(d.x);
+    return boxBit(b, brickMin_, brickMax_);
 }
 
 bool BrickVolume::occupied(const glm::ivec3& b) const {
@@ -131,20 +137,28 @@ bool BrickVolume::occupied(const glm::ivec3& b) const {
     return (occupancy_[bit >> 6] >> (bit & 63)) & 1u;
 }
 
+bool BrickVolume::superOccupied(const glm::ivec3& sb) const {
+    if (glm::any(glm::lessThan(sb, superMin_)) || glm::any(glm::greaterThan(sb, superMax_)))
+        return false;
+    const std::size_t bit = boxBit(sb, superMin_, superMax_);
+    return (superOccupancy_[bit >> 6] >> (bit & 63)) & 1u;
+}
+
 void BrickVolume::allocateSlots() {
     if (brickCount_ > 0) {
         occupancy_.assign(occupancyBit(brickMax_) / 64 + 1, 0);
+        // Floor division by kSuper = 4 (C++20: arithmetic shift).
+        superMin_ = brickMin_ >> 2;
+        superMax_ = brickMax_ >> 2;
+        superOccupancy_.assign(boxBit(superMax_, superMin_, superMax_) / 64 + 1, 0);
         for (const glm::ivec3& b : brickCoord_) {
             const std::size_t bit = occupancyBit(b);
             occupancy_[bit >> 6] |= std::uint64_t(1) << (bit & 63);
+            const std::size_t superBit = boxBit(b >> 2, superMin_, superMax_);
+            superOccupancy_[superBit >> 6] |= std::uint64_t(1) << (superBit & 63);
         }
     }
-    slotIndex_.resize(brickCount_ * std::size_t(kBrickValues));
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, brickCount_, 256), [&](const auto& r) {
-        std::fill(slotIndex_.begin() + static_cast<std::ptrdiff_t>(r.begin() * kBrickValues),
-                  slotIndex_.begin() + static_cast<std::ptrdiff_t>(r.end() * kBrickValues),
-                  kAbsent);
-    });
+    present_.assign(brickCount_, SlotBits{});
 }
 
 void BrickVolume::allocateValues() {
@@ -154,23 +168,23 @@ void BrickVolume::allocateValues() {
     cellMask_.assign(brickCount_, {});
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, brickCount_, 64), [&](const auto& r) {
         for (std::size_t brick = r.begin(); brick != r.end(); ++brick) {
-            std::uint16_t* slots = &slotIndex_[brick * kBrickValues];
+            SlotBits& slots = present_[brick];
             std::uint16_t next = 0;
-            for (int x = 0; x < kSide; ++x)
-                for (int y = 0; y < kSide; ++y)
-                    for (int z = 0; z < kSide; ++z) {
-                        std::uint16_t& slot = slots[valueIndex(x, y, z)];
-                        if (slot == kAbsent)
-                            continue;
-                        slot = next++;
-                        // The value is a corner of the cells (x − 1 .. x, y − 1 .. y, z − 1 .. z).
-                        for (int cx = std::max(x - 1, 0); cx <= std::min(x, kBrick - 1); ++cx)
-                            for (int cy = std::max(y - 1, 0); cy <= std::min(y, kBrick - 1); ++cy)
-                                for (int cz = std::max(z - 1, 0); cz <= std::min(z, kBrick - 1);
-                                     ++cz)
-                                    cellMask_[brick][std::size_t(cx)] |= std::uint64_t(1)
-                                                                         << (cy * 8 + cz);
-                    }
+            for (std::size_t w = 0; w < kSlotWords; ++w) {
+                slots.rank[w] = next;
+                for (std::uint64_t word = slots.bits[w]; word != 0; word &= word - 1) {
+                    ++next;
+                    const int slot = int(w) * 64 + std::countr_zero(word);
+                    const int x = slot / (kSide * kSide), y = slot / kSide % kSide,
+                              z = slot % kSide;
+                    // The value is a corner of the cells (x − 1 .. x, y − 1 .. y, z − 1 .. z).
+                    for (int cx = std::max(x - 1, 0); cx <= std::min(x, kBrick - 1); ++cx)
+                        for (int cy = std::max(y - 1, 0); cy <= std::min(y, kBrick - 1); ++cy)
+                            for (int cz = std::max(z - 1, 0); cz <= std::min(z, kBrick - 1); ++cz)
+                                cellMask_[brick][std::size_t(cx)] |= std::uint64_t(1)
+                                                                     << (cy * 8 + cz);
+                }
+            }
             counts[brick] = next;
         }
     });
@@ -213,15 +227,16 @@ void BrickVolume::forEachCopy(const BrickSet& bricks, const glm::ivec3& local, F
 }
 
 void BrickVolume::reserveVoxel(const BrickSet& bricks, const glm::ivec3& local) {
+    // Voxels of neighbouring leaves share the aprons' words: set bits atomically.
     forEachCopy(bricks, local, [&](std::size_t brick, int slot) {
-        slotIndex_[brick * kBrickValues + static_cast<std::size_t>(slot)] = kReserved;
+        std::atomic_ref(present_[brick].bits[static_cast<std::size_t>(slot >> 6)])
+            .fetch_or(std::uint64_t(1) << (slot & 63), std::memory_order_relaxed);
     });
 }
 
 void BrickVolume::set(const BrickSet& bricks, const glm::ivec3& local, const OpticalDepths& value) {
     forEachCopy(bricks, local, [&](std::size_t brick, int slot) {
-        const std::uint16_t i = slotIndex_[brick * kBrickValues + static_cast<std::size_t>(slot)];
-        values_[valueBase_[brick] + i] = Lanes::from(value);
+        values_[valueAt(brick, slot)] = Lanes::from(value);
     });
 }
 
@@ -243,14 +258,26 @@ void BrickVolume::walkBricks(const Vec3f& O, const Vec3f& dir, float s0, float s
     }
     if (!(s0 < s1))
         return;
-    // Bricks are cells 8 index units wide: traverse the line scaled by 1/8.
+    // Bricks are cells 8 index units wide, super-bricks 8·kSuper: traverse
+    // the line scaled by 1/(8·kSuper), then by 1/8 within the occupied ones.
+    static_assert(kSuper == 4, "the super-brick shifts are by 2");
+    const GridLine<float> inSupers(O / float(kBrick * kSuper), dir / float(kBrick * kSuper));
     const GridLine<float> inBricks(O / float(kBrick), dir / float(kBrick));
-    traverseCells(inBricks, s0, s1, brickMin_, brickMax_,
-                  [&](const glm::ivec3& b, float sEnter, float sExit) {
-                      if (!occupied(b))
-                          return true;
-                      return visit(static_cast<std::size_t>(find(b)), b, sEnter, sExit);
-                  });
+    traverseCells(
+        inSupers, s0, s1, superMin_, superMax_,
+        [&](const glm::ivec3& sb, float sEnterSuper, float sExitSuper) {
+            if (!superOccupied(sb))
+                return true;
+            return traverseCells(inBricks, sEnterSuper, sExitSuper,
+                                 glm::max(sb * kSuper, brickMin_),
+                                 glm::min(sb * kSuper + (kSuper - 1), brickMax_),
+                                 [&](const glm::ivec3& b, float sEnter, float sExit) {
+                                     if (!occupied(b))
+                                         return true;
+                                     return visit(static_cast<std::size_t>(find(b)), b, sEnter,
+                                                  sExit);
+                                 });
+        });
 }
 
 template <typename NextSplit, typename OnPiece>
