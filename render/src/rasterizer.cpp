@@ -327,7 +327,7 @@ struct TileScratch {
     std::vector<float> vertexResults;        ///< per vertex slot: stride floats
     std::vector<ShadingPoint> points;
     std::vector<float> results;  ///< per point of a batch: stride floats
-    std::vector<float> lerped;   ///< one interpolated vertex-rate result
+    std::vector<float> lerped;   ///< one interpolated result (vertex and adaptive rates)
     std::vector<std::uint32_t> probed;   ///< adaptive rate: local segments shaded at t = 0, ½, 1
     std::vector<float> probeResults;     ///< per probed segment: 3 × stride floats
     std::vector<std::uint32_t> probeOf;  ///< per local segment: its smooth probe, or none
