@@ -601,7 +601,8 @@ std::ostream& operator<<(std::ostream& os, const Scene& s) {
     }
     os << ", mode=" << s.globalTermMode
        << ", voxel=" << (s.voxelSize ? strCat(*s.voxelSize) : std::string("auto"))
-       << ", exact(rays=" << s.exact.rays << ", r=" << s.exact.radius << "), rate=" << s.shadingRate << " (tolerance " << s.shadingTolerance << ")"
+       << ", exact(rays=" << s.exact.rays << ", r=" << s.exact.radius << "), rate=" << s.shadingRate
+       << " (tolerance " << s.shadingTolerance << ")"
        << ", background=" << s.background << ", exr='" << s.output.exr.string() << "', png='"
        << s.output.png.string() << "', exposure=" << s.output.exposure
        << ", tone_map=" << toString(s.output.toneMap) << ")";

@@ -278,6 +278,8 @@ void binSegments(RenderContext& ctx, RasterStats& stats) {
 // --- one tile ----------------------------------------------------------------
 
 constexpr std::uint32_t kNoPoint = std::numeric_limits<std::uint32_t>::max();
+/// No vertex slot (vertex rate) or no smooth probe (adaptive rate) for a segment.
+constexpr std::uint32_t kNoSlot = std::numeric_limits<std::uint32_t>::max();
 /// Segments rasterized between two compositing steps (see TileRenderer).
 constexpr std::size_t kSegmentsPerStep = 64;
 
@@ -704,6 +706,22 @@ private:
         shadeEach(s_.visible);
     }
 
+    /// Shades points pointAt(0 .. n − 1), in batches, into `out` (n × stride
+    /// floats); `where` names them in warnings.
+    template <typename PointAt>
+    void shadeInto(std::size_t n, PointAt&& pointAt, const char* where, std::vector<float>& out) {
+        out.resize(n * stride_);
+        for (std::size_t begin = 0; begin < n; begin += kShadeBatch) {
+            const std::size_t count = std::min(kShadeBatch, n - begin);
+            s_.points.resize(count);
+            for (std::size_t i = 0; i < count; ++i)
+                s_.points[i] = pointAt(begin + i);
+            shadeBatch(count, [&](std::size_t) { return std::string(where); });
+            std::copy_n(s_.results.begin(), count * stride_,
+                        out.begin() + std::ptrdiff_t(begin * stride_));
+        }
+    }
+
     /// Shades each fragment at its point, in batches, into its pixel's sums.
     void shadeEach(std::span<const Visible> fragments) {
         for (std::size_t begin = 0; begin < fragments.size(); begin += kShadeBatch) {
@@ -724,14 +742,13 @@ private:
         // Vertex slots of the segments with a visible fragment, in segment
         // order; a segment's tip-side vertex is always the slot after its
         // root-side one, which the next segment of the strand reuses.
-        constexpr std::uint32_t none = std::numeric_limits<std::uint32_t>::max();
-        s_.vertexSlot.assign(bins_.size(), none);
+        s_.vertexSlot.assign(bins_.size(), kNoSlot);
         for (const Visible& v : s_.visible)
             s_.vertexSlot[v.local] = 0;
         s_.slotPoint.clear();
         s_.slotStrand.clear();
         for (std::size_t i = 0; i < bins_.size(); ++i) {
-            if (s_.vertexSlot[i] == none)
+            if (s_.vertexSlot[i] == kNoSlot)
                 continue;
             const std::uint32_t k = s_.pointOf[i];
             if (s_.slotPoint.empty() || s_.slotPoint.back() != k) {
@@ -742,17 +759,10 @@ private:
             s_.slotPoint.push_back(k + 1);
             s_.slotStrand.push_back(s_.strandOf[i]);
         }
-        const std::size_t slots = s_.slotPoint.size();
-        s_.vertexResults.resize(slots * stride_);
-        for (std::size_t begin = 0; begin < slots; begin += kShadeBatch) {
-            const std::size_t count = std::min(kShadeBatch, slots - begin);
-            s_.points.resize(count);
-            for (std::size_t i = 0; i < count; ++i)
-                s_.points[i] = pointAtVertex(s_.slotPoint[begin + i], s_.slotStrand[begin + i]);
-            shadeBatch(count, [&](std::size_t) { return std::string("at a strand vertex"); });
-            std::copy_n(s_.results.begin(), count * stride_,
-                        s_.vertexResults.begin() + std::ptrdiff_t(begin * stride_));
-        }
+        shadeInto(
+            s_.slotPoint.size(),
+            [&](std::size_t j) { return pointAtVertex(s_.slotPoint[j], s_.slotStrand[j]); },
+            "at a strand vertex", s_.vertexResults);
         s_.lerped.resize(stride_);
         result_.interpolated += s_.visible.size();
         for (const Visible& v : s_.visible) {
@@ -781,23 +791,14 @@ private:
         for (std::size_t i = 0; i < bins_.size(); ++i)
             if (fragmentsOf(i) > kProbePoints)
                 s_.probed.push_back(static_cast<std::uint32_t>(i));
-        const std::size_t probePoints = kProbePoints * s_.probed.size();
-        s_.probeResults.resize(probePoints * stride_);
-        for (std::size_t begin = 0; begin < probePoints; begin += kShadeBatch) {
-            const std::size_t count = std::min(kShadeBatch, probePoints - begin);
-            s_.points.resize(count);
-            for (std::size_t i = 0; i < count; ++i) {
-                const std::size_t j = begin + i;
-                s_.points[i] = pointOnSegment(s_.probed[j / kProbePoints],
-                                              0.5f * float(j % kProbePoints));
-            }
-            shadeBatch(count, [&](std::size_t) { return std::string("probing a segment"); });
-            std::copy_n(s_.results.begin(), count * stride_,
-                        s_.probeResults.begin() + std::ptrdiff_t(begin * stride_));
-        }
+        shadeInto(
+            kProbePoints * s_.probed.size(),
+            [&](std::size_t j) {
+                return pointOnSegment(s_.probed[j / kProbePoints], 0.5f * float(j % kProbePoints));
+            },
+            "probing a segment", s_.probeResults);
 
-        constexpr std::uint32_t none = std::numeric_limits<std::uint32_t>::max();
-        s_.probeOf.assign(bins_.size(), none);
+        s_.probeOf.assign(bins_.size(), kNoSlot);
         for (std::size_t p = 0; p < s_.probed.size(); ++p) {
             const float* a = s_.probeResults.data() + kProbePoints * p * stride_;
             if (smoothAlong(a, a + stride_, a + 2 * stride_, ctx_.radianceFloats,
@@ -814,7 +815,7 @@ private:
         s_.lerped.resize(stride_);
         for (const Visible& v : s_.visible) {
             const std::uint32_t p = s_.probeOf[v.local];
-            if (p == none) {
+            if (p == kNoSlot) {
                 s_.grouped.push_back(v);
                 continue;
             }

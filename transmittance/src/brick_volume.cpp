@@ -8,11 +8,11 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <memory>
 #include <new>
 #include <limits>
-#include <atomic>
 #include <span>
 
 namespace hairvox::detail {
@@ -57,6 +57,26 @@ std::size_t boxBit(const glm::ivec3& c, const glm::ivec3& lo, const glm::ivec3& 
            std::size_t(d.x);
 }
 
+/// A bitmap over the box [lo, hi], one bit per cell, all clear.
+std::vector<std::uint64_t> boxBitmap(const glm::ivec3& lo, const glm::ivec3& hi) {
+    return std::vector<std::uint64_t>(boxBit(hi, lo, hi) / 64 + 1, 0);
+}
+
+void setBoxBit(std::vector<std::uint64_t>& bits, const glm::ivec3& c, const glm::ivec3& lo,
+               const glm::ivec3& hi) {
+    const std::size_t bit = boxBit(c, lo, hi);
+    bits[bit >> 6] |= std::uint64_t(1) << (bit & 63);
+}
+
+/// Whether cell c is set (false outside the box).
+bool boxBitSet(const std::vector<std::uint64_t>& bits, const glm::ivec3& c, const glm::ivec3& lo,
+               const glm::ivec3& hi) {
+    if (glm::any(glm::lessThan(c, lo)) || glm::any(glm::greaterThan(c, hi)))
+        return false;
+    const std::size_t bit = boxBit(c, lo, hi);
+    return (bits[bit >> 6] >> (bit & 63)) & 1u;
+}
+
 } // namespace
 
 const Lanes BrickVolume::kZero{};
@@ -70,7 +90,7 @@ std::size_t BrickVolume::memoryBytes() const {
     return valueCount_ * sizeof(Lanes) + present_.capacity() * sizeof(SlotBits) +
            valueBase_.capacity() * sizeof(std::size_t) +
            cellMask_.capacity() * sizeof(cellMask_[0]) +
-           occupancy_.capacity() * sizeof(std::uint64_t) +
+           (occupancy_.capacity() + superOccupancy_.capacity()) * sizeof(std::uint64_t) +
            brickCoord_.capacity() * sizeof(glm::ivec3) + slots_.capacity() * sizeof(std::int64_t);
 }
 
@@ -126,36 +146,24 @@ void BrickVolume::AlignedDelete::operator()(Lanes* p) const {
     ::operator delete[](p, std::align_val_t(alignof(Lanes)));
 }
 
-std::size_t BrickVolume::occupancyBit(const glm::ivec3& b) const {
-    return boxBit(b, brickMin_, brickMax_);
-}
-
 bool BrickVolume::occupied(const glm::ivec3& b) const {
-    if (glm::any(glm::lessThan(b, brickMin_)) || glm::any(glm::greaterThan(b, brickMax_)))
-        return false;
-    const std::size_t bit = occupancyBit(b);
-    return (occupancy_[bit >> 6] >> (bit & 63)) & 1u;
+    return boxBitSet(occupancy_, b, brickMin_, brickMax_);
 }
 
 bool BrickVolume::superOccupied(const glm::ivec3& sb) const {
-    if (glm::any(glm::lessThan(sb, superMin_)) || glm::any(glm::greaterThan(sb, superMax_)))
-        return false;
-    const std::size_t bit = boxBit(sb, superMin_, superMax_);
-    return (superOccupancy_[bit >> 6] >> (bit & 63)) & 1u;
+    return boxBitSet(superOccupancy_, sb, superMin_, superMax_);
 }
 
 void BrickVolume::allocateSlots() {
     if (brickCount_ > 0) {
-        occupancy_.assign(occupancyBit(brickMax_) / 64 + 1, 0);
-        // Floor division by kSuper = 4 (C++20: arithmetic shift).
-        superMin_ = brickMin_ >> 2;
-        superMax_ = brickMax_ >> 2;
-        superOccupancy_.assign(boxBit(superMax_, superMin_, superMax_) / 64 + 1, 0);
+        // Floor division by kSuper (C++20: arithmetic shift).
+        superMin_ = brickMin_ >> kSuperShift;
+        superMax_ = brickMax_ >> kSuperShift;
+        occupancy_ = boxBitmap(brickMin_, brickMax_);
+        superOccupancy_ = boxBitmap(superMin_, superMax_);
         for (const glm::ivec3& b : brickCoord_) {
-            const std::size_t bit = occupancyBit(b);
-            occupancy_[bit >> 6] |= std::uint64_t(1) << (bit & 63);
-            const std::size_t superBit = boxBit(b >> 2, superMin_, superMax_);
-            superOccupancy_[superBit >> 6] |= std::uint64_t(1) << (superBit & 63);
+            setBoxBit(occupancy_, b, brickMin_, brickMax_);
+            setBoxBit(superOccupancy_, b >> kSuperShift, superMin_, superMax_);
         }
     }
     present_.assign(brickCount_, SlotBits{});
@@ -260,7 +268,6 @@ void BrickVolume::walkBricks(const Vec3f& O, const Vec3f& dir, float s0, float s
         return;
     // Bricks are cells 8 index units wide, super-bricks 8·kSuper: traverse
     // the line scaled by 1/(8·kSuper), then by 1/8 within the occupied ones.
-    static_assert(kSuper == 4, "the super-brick shifts are by 2");
     const GridLine<float> inSupers(O / float(kBrick * kSuper), dir / float(kBrick * kSuper));
     const GridLine<float> inBricks(O / float(kBrick), dir / float(kBrick));
     traverseCells(

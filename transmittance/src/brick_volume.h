@@ -155,8 +155,6 @@ private:
     /// Whether brick b exists, from the occupancy bits (no hashing): what a
     /// line's walk asks of every brick position it crosses.
     bool occupied(const glm::ivec3& b) const;
-    /// Brick b's bit in occupancy_ (b within [brickMin_, brickMax_]).
-    std::size_t occupancyBit(const glm::ivec3& b) const;
     /// Whether any brick of super-brick sb (kSuper³ bricks) exists.
     bool superOccupied(const glm::ivec3& sb) const;
     std::int64_t insert(const glm::ivec3& b);
@@ -220,7 +218,8 @@ private:
     /// crosses empty space a super-brick at a time. At fine voxels the bricks
     /// are sparse (Ratboy at 0.5 mm: 95% of the brick positions lines cross
     /// are empty) and walking them one by one grew faster than the hair.
-    static constexpr int kSuper = 4;
+    static constexpr int kSuperShift = 2;
+    static constexpr int kSuper = 1 << kSuperShift;
     glm::ivec3 superMin_{0}, superMax_{-1};
     std::vector<std::uint64_t> superOccupancy_;
 };
