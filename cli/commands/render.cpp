@@ -36,7 +36,7 @@ struct RenderCommandOptions {
     std::optional<std::uint64_t> seed;
     bool continueRun = false;
     std::optional<std::uint32_t> width, height;
-    std::optional<float> voxelSize, shadingTolerance;
+    std::optional<float> voxelSize, shadingTolerance, tailTransmittance;
     std::optional<double> maxMemoryGiB;
     int threads = 0;
     bool quiet = false;
@@ -144,6 +144,12 @@ void runRender(const RenderCommandOptions& opt) {
                              "(--shading-rate adaptive)");
         scene.shadingTolerance = *opt.shadingTolerance;
     }
+    if (opt.tailTransmittance) {
+        if (scene.shadingRate == ShadingRate::Vertex)
+            throw InputError("--tail-transmittance applies to the fragment and adaptive shading "
+                             "rates (the vertex rate interpolates all the hair)");
+        scene.tailTransmittance = *opt.tailTransmittance;
+    }
     if (!opt.exrCompression.empty())
         scene.output.exrCompression = *kExrCompressionNames.parse(opt.exrCompression);
     if ((opt.spp || opt.timeLimit || opt.seed || opt.continueRun) &&
@@ -210,6 +216,11 @@ void addRenderCommand(CLI::App& app) {
     cmd->add_option("--shading-tolerance", opt->shadingTolerance,
                     "Adaptive rate: a segment is interpolated when its midpoint is within this "
                     "fraction of its mean radiance from the ends' interpolation [0, 1]")
+        ->check(CLI::Range(0.0f, 1.0f));
+    cmd->add_option("--tail-transmittance", opt->tailTransmittance,
+                    "Fragment and adaptive rates: hair seen through less than this transmittance "
+                    "interpolates strand-vertex results instead of being shaded; 0: none "
+                    "(default 1/16, docs/scene.md) [0, 1]")
         ->check(CLI::Range(0.0f, 1.0f));
     cmd->add_option("--exr-compression", opt->exrCompression,
                     "EXR compression: rle (default), zips, zip or none; overrides the scene's "

@@ -212,6 +212,7 @@ RasterSettings rasterSettings(const Scene& scene, const PipelineOptions& options
     s.fiberScale = scene.fiberScale;
     s.shadingRate = scene.shadingRate;
     s.shadingTolerance = scene.shadingTolerance;
+    s.tailTransmittance = scene.tailTransmittance;
     s.background = scene.background;
     s.threads = options.threads;
     s.progress = options.progress;
@@ -717,12 +718,17 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
                      thousands(st.smoothSegments), " of ", thousands(st.probedSegments),
                      " probed segment-tiles smooth")
             : strCat(toString(scene.shadingRate), " rate");
+    const std::uint64_t rateInterpolated = st.fragmentsInterpolated - st.tailFragments;
     row("shade", r.times.shade,
         strCat(thousands(st.shadingPoints), " shading points (", rate, "); skipped ",
                thousands(st.fragmentsBehindOpaque), " fragments behind opaque pixels",
-               st.fragmentsInterpolated > 0
-                   ? strCat(", ", thousands(st.fragmentsInterpolated),
-                            " visible fragments interpolated instead of shaded")
+               rateInterpolated > 0 ? strCat(", ", thousands(rateInterpolated),
+                                             " visible fragments interpolated instead of shaded")
+                                    : std::string(),
+               st.tailFragments > 0
+                   ? strCat(", ", thousands(st.tailFragments),
+                            " seen through transmittance < ", scene.tailTransmittance,
+                            " interpolated from ", thousands(st.tailVertices), " strand vertices")
                    : std::string()));
     row("write", r.times.write, written.empty() ? "nothing" : written);
 }

@@ -31,6 +31,7 @@ constexpr std::uint64_t kMaxExactRays = 65536;
 constexpr Range kExactRadius{0.0, 1000.0};
 constexpr Range kBackground{0.0, 1e6};
 constexpr Range kShadingTolerance{0.0, 1.0};
+constexpr Range kTailTransmittance{0.0, 1.0};
 constexpr Range kExposure{-20.0, 20.0};
 constexpr Range kTimeLimit{0.0, 1e7};
 constexpr Range kDegrees{-360.0, 360.0};
@@ -419,6 +420,7 @@ void Scene::validate() const {
     requireInRange("global_term.exact.radius", exact.radius, kExactRadius);
     requireInRange("background", background, kBackground);
     requireInRange("shading_tolerance", shadingTolerance, kShadingTolerance);
+    requireInRange("tail_transmittance", tailTransmittance, kTailTransmittance);
     try {
         pathTrace.validate();
     } catch (const InputError& e) {
@@ -527,6 +529,12 @@ Scene parseScene(const nlohmann::json& document, const std::string& sourceName,
             v.fail("applies to the adaptive shading rate only (\"shading_rate\": \"adaptive\")");
         scene.shadingTolerance = v.numberF(kShadingTolerance);
     }
+    if (const JsonValue v = root["tail_transmittance"]; v.present()) {
+        if (scene.shadingRate == ShadingRate::Vertex)
+            v.fail("applies to the fragment and adaptive shading rates (the vertex rate "
+                   "interpolates all the hair)");
+        scene.tailTransmittance = v.numberF(kTailTransmittance);
+    }
     if (const JsonValue v = root["background"]; v.present())
         scene.background = v.rgb(kBackground);
 
@@ -602,7 +610,7 @@ std::ostream& operator<<(std::ostream& os, const Scene& s) {
     os << ", mode=" << s.globalTermMode
        << ", voxel=" << (s.voxelSize ? strCat(*s.voxelSize) : std::string("auto"))
        << ", exact(rays=" << s.exact.rays << ", r=" << s.exact.radius << "), rate=" << s.shadingRate
-       << " (tolerance " << s.shadingTolerance << ")"
+       << " (tolerance " << s.shadingTolerance << ", tail " << s.tailTransmittance << ")"
        << ", background=" << s.background << ", exr='" << s.output.exr.string() << "', png='"
        << s.output.png.string() << "', exposure=" << s.output.exposure
        << ", tone_map=" << toString(s.output.toneMap) << ")";

@@ -95,6 +95,20 @@ bool segmentNearBox(const Vec2d& a, const Vec2d& b, Vec2d lo, Vec2d hi, double r
     return true;
 }
 
+/// A segment: the point index of its root-side vertex, and its strand. One
+/// record, so that a tile's gather of its segments misses the cache once each.
+struct SegmentRef {
+    std::uint32_t firstPoint;
+    std::uint32_t strand;
+};
+
+/// A tile reads its segments' records and vertices scattered across the
+/// groom: it asks for them this many segments ahead (a record twice as far,
+/// since the vertices' address needs it), so that the misses overlap.
+constexpr std::size_t kPrefetchAhead = 8;
+
+inline void prefetch(const void* address) { __builtin_prefetch(address); }
+
 /// Everything the tiles share.
 struct RenderContext {
     const Groom& groom;
@@ -107,8 +121,7 @@ struct RenderContext {
     std::size_t radianceFloats; ///< of those, the radiance layers'
     std::vector<Vec3f> tangents;
     std::vector<raster::ProjectedVertex> projected; ///< per point
-    std::vector<std::uint32_t> firstPoint; ///< per segment: the point index of its root-side vertex
-    std::vector<std::uint32_t> strandOf;   ///< per segment: its strand
+    std::vector<SegmentRef> segments; ///< per segment
     int tilesX = 0, tilesY = 0;
     /// Per tile: the farthest surface depth if surfaces cover every pixel wholly, else +∞.
     std::vector<float> tileSurfaceDepth;
@@ -132,7 +145,7 @@ struct RenderContext {
         , radianceFloats(layout.radianceFloats()) {}
 
     std::optional<ScreenRibbon> ribbon(std::uint32_t segment) const {
-        const std::uint32_t k = firstPoint[segment];
+        const std::uint32_t k = segments[segment].firstPoint;
         if (projected[k].valid() && projected[k + 1].valid())
             return raster::ribbonBetween(projected[k], projected[k + 1]);
         return raster::projectRibbon(
@@ -170,24 +183,20 @@ std::vector<float> tileSurfaceDepths(const SurfaceLayer& surfaces, int width, in
 }
 
 /// Per segment, its root-side point and its strand.
-void indexSegments(const Groom& groom, std::vector<std::uint32_t>& firstPoint,
-                   std::vector<std::uint32_t>& strandOf) {
-    firstPoint.clear();
-    strandOf.clear();
-    firstPoint.reserve(groom.segmentCount());
-    strandOf.reserve(groom.segmentCount());
+std::vector<SegmentRef> indexSegments(const Groom& groom) {
+    std::vector<SegmentRef> segments;
+    segments.reserve(groom.segmentCount());
     for (std::size_t s = 0; s < groom.strandCount(); ++s)
-        for (std::uint32_t k = groom.strandStart[s]; k + 1 < groom.strandStart[s + 1]; ++k) {
-            firstPoint.push_back(k);
-            strandOf.push_back(static_cast<std::uint32_t>(s));
-        }
+        for (std::uint32_t k = groom.strandStart[s]; k + 1 < groom.strandStart[s + 1]; ++k)
+            segments.push_back({k, static_cast<std::uint32_t>(s)});
+    return segments;
 }
 
 /// Bins segments to the tiles their ribbon may touch. Chunks of segments are
 /// counted, then written, in chunk order: each tile's list is sorted by
 /// segment index whatever the thread count.
 void binSegments(RenderContext& ctx, RasterStats& stats) {
-    const std::size_t segments = ctx.firstPoint.size();
+    const std::size_t segments = ctx.segments.size();
     const std::size_t tiles = std::size_t(ctx.tilesX) * std::size_t(ctx.tilesY);
     const std::size_t chunkSize = std::max(kMinBinChunk, (segments + 255) / 256);
     const std::size_t chunks = (segments + chunkSize - 1) / chunkSize;
@@ -321,6 +330,7 @@ struct TileScratch {
     std::vector<std::uint32_t> pixelStart, cursor;
     std::vector<PixelState> pixels;
     std::vector<Visible> visible;
+    std::vector<Visible> tail; ///< visible behind the tail transmittance: interpolated
     std::vector<Visible> grouped;            ///< visible, ordered by segment
     std::vector<std::uint32_t> segmentStart; ///< per local segment: its first grouped fragment
     std::vector<std::uint32_t> vertexSlot;   ///< per local segment: slot of its root-side vertex
@@ -329,7 +339,7 @@ struct TileScratch {
     std::vector<float> vertexResults;        ///< per vertex slot: stride floats
     std::vector<ShadingPoint> points;
     std::vector<float> results;  ///< per point of a batch: stride floats
-    std::vector<float> lerped;   ///< one interpolated result (vertex and adaptive rates)
+    std::vector<float> lerped;   ///< one interpolated result
     std::vector<std::uint32_t> probed;   ///< adaptive rate: local segments shaded at t = 0, ½, 1
     std::vector<float> probeResults;     ///< per probed segment: 3 × stride floats
     std::vector<std::uint32_t> probeOf;  ///< per local segment: its smooth probe, or none
@@ -341,6 +351,7 @@ struct TileResult {
     std::uint64_t fragments = 0, behindOpaque = 0, composited = 0, shadingPoints = 0, invalid = 0;
     std::uint64_t segmentsSkipped = 0;
     std::uint64_t probedSegments = 0, smoothSegments = 0, interpolated = 0;
+    std::uint64_t tailFragments = 0, tailVertices = 0;
     std::vector<std::string> warnings;
 };
 
@@ -412,6 +423,8 @@ public:
         area_ = static_cast<std::uint32_t>(width_ * (y1_ - y0_));
         bins_ = {ctx.binSegments.data() + ctx.binStart[std::size_t(tile)],
                  ctx.binSegments.data() + ctx.binStart[std::size_t(tile) + 1]};
+        if (ctx.settings.shadingRate != ShadingRate::Vertex)
+            tailTransmittance_ = ctx.settings.tailTransmittance;
     }
 
     TileResult run() {
@@ -452,10 +465,17 @@ private:
         s_.pointOf.resize(n);
         s_.keys.resize(n);
         for (std::size_t i = 0; i < n; ++i) {
+            if (i + 2 * kPrefetchAhead < n)
+                prefetch(&ctx_.segments[bins_[i + 2 * kPrefetchAhead]]);
+            if (i + kPrefetchAhead < n) {
+                const std::uint32_t k = ctx_.segments[bins_[i + kPrefetchAhead]].firstPoint;
+                prefetch(&ctx_.projected[k]);
+                prefetch(&ctx_.projected[k + 1].invZ); // the pair's end: the next line at most
+            }
             s_.ribbons[i] = *ctx_.ribbon(bins_[i]);
             s_.zMin[i] = 1.0f / std::max(s_.ribbons[i].invZ0, s_.ribbons[i].invZ1);
-            s_.pointOf[i] = ctx_.firstPoint[bins_[i]];
-            s_.strandOf[i] = ctx_.strandOf[bins_[i]];
+            s_.pointOf[i] = ctx_.segments[bins_[i]].firstPoint;
+            s_.strandOf[i] = ctx_.segments[bins_[i]].strand;
             // (zMin, index) as one integer: positive floats order like their bits.
             s_.keys[i] = (std::uint64_t(std::bit_cast<std::uint32_t>(s_.zMin[i])) << 32) | i;
         }
@@ -466,6 +486,7 @@ private:
         openPixels_ = area_;
         s_.pending.clear();
         s_.visible.clear();
+        s_.tail.clear();
         if (ctx_.surfaces.empty())
             return;
         for (int y = y0_; y < y1_; ++y)
@@ -582,7 +603,9 @@ private:
         st.lastPoint = point;
         st.depthSum += w * f.depth;
         if (hair) {
-            s_.visible.push_back({f.pixel, f.local, f.t, w});
+            // Seen through less than the tail transmittance: interpolated.
+            (st.groupT < tailTransmittance_ ? s_.tail : s_.visible)
+                .push_back({f.pixel, f.local, f.t, w});
             st.hairWeight += w;
             ++result_.composited;
         } else {
@@ -702,6 +725,7 @@ private:
 
     void shadeFragments() {
         s_.pixelSum.assign(std::size_t(area_) * stride_, 0.0f);
+        interpolateTail();
         groupVisibleBySegment();
         shadeEach(s_.visible);
     }
@@ -728,6 +752,13 @@ private:
             const std::size_t count = std::min(kShadeBatch, fragments.size() - begin);
             s_.points.resize(count);
             for (std::size_t i = 0; i < count; ++i) {
+                if (begin + i + kPrefetchAhead < fragments.size()) {
+                    const std::uint32_t k = s_.pointOf[fragments[begin + i + kPrefetchAhead].local];
+                    prefetch(&ctx_.groom.points[k]);
+                    prefetch(&ctx_.groom.points[k + 1]);
+                    prefetch(&ctx_.tangents[k]);
+                    prefetch(&ctx_.tangents[k + 1]);
+                }
                 const Visible& v = fragments[begin + i];
                 s_.points[i] = pointOnSegment(v.local, v.t);
             }
@@ -739,11 +770,27 @@ private:
 
     void shadeVertices() {
         s_.pixelSum.assign(std::size_t(area_) * stride_, 0.0f);
-        // Vertex slots of the segments with a visible fragment, in segment
-        // order; a segment's tip-side vertex is always the slot after its
-        // root-side one, which the next segment of the strand reuses.
+        interpolateVertices(s_.visible);
+    }
+
+    /// Fragment and adaptive rates: the hair behind the tail transmittance
+    /// interpolates its segments' vertices.
+    void interpolateTail() {
+        const std::uint64_t shaded = result_.shadingPoints;
+        interpolateVertices(s_.tail);
+        result_.tailFragments += s_.tail.size();
+        result_.tailVertices += result_.shadingPoints - shaded;
+    }
+
+    /// Shades the strand vertices of the segments of `fragments` (vertex
+    /// slots in segment order; a segment's tip-side vertex is always the slot
+    /// after its root-side one, which the next segment of the strand reuses)
+    /// and adds each fragment's interpolation of its segment's two vertices.
+    void interpolateVertices(std::span<const Visible> fragments) {
+        if (fragments.empty())
+            return;
         s_.vertexSlot.assign(bins_.size(), kNoSlot);
-        for (const Visible& v : s_.visible)
+        for (const Visible& v : fragments)
             s_.vertexSlot[v.local] = 0;
         s_.slotPoint.clear();
         s_.slotStrand.clear();
@@ -764,8 +811,8 @@ private:
             [&](std::size_t j) { return pointAtVertex(s_.slotPoint[j], s_.slotStrand[j]); },
             "at a strand vertex", s_.vertexResults);
         s_.lerped.resize(stride_);
-        result_.interpolated += s_.visible.size();
-        for (const Visible& v : s_.visible) {
+        result_.interpolated += fragments.size();
+        for (const Visible& v : fragments) {
             const float* a =
                 s_.vertexResults.data() + std::size_t(s_.vertexSlot[v.local]) * stride_;
             lerpResult(v.t, a, a + stride_);
@@ -783,6 +830,7 @@ private:
     /// the tile's fragments: neither on the threads.
     void shadeAdaptive() {
         s_.pixelSum.assign(std::size_t(area_) * stride_, 0.0f);
+        interpolateTail();
         groupVisibleBySegment();
         auto fragmentsOf = [&](std::size_t i) {
             return s_.segmentStart[i + 1] - s_.segmentStart[i];
@@ -873,6 +921,9 @@ private:
     std::uint32_t area_;
     std::span<const std::uint32_t> bins_;
     std::size_t openPixels_ = 0;
+    /// Hair behind this transmittance is interpolated from strand vertices
+    /// (none at vertex rate: everything is).
+    float tailTransmittance_ = 0;
     TileResult result_;
 };
 
@@ -887,7 +938,8 @@ std::ostream& operator<<(std::ostream& os, const RasterStats& s) {
               << " composited, " << s.fragmentsBehindOpaque << " behind opaque pixels; "
               << s.shadingPoints << " shading points, " << s.fragmentsInterpolated
               << " fragments interpolated, " << s.smoothSegments << " of " << s.probedSegments
-              << " probed segments smooth, " << s.invalidSamples << " rejected; "
+              << " probed segments smooth, " << s.tailFragments << " behind the tail from "
+              << s.tailVertices << " vertices, " << s.invalidSamples << " rejected; "
               << s.tiles << " tiles)";
 }
 
@@ -900,6 +952,9 @@ RasterOutput rasterize(const Groom& groom, const Camera& camera, const FragmentS
                                 ": expected a number in [0, 1)"));
     if (!(settings.shadingTolerance >= 0.0f && settings.shadingTolerance <= 1.0f))
         throw InputError(strCat("shading tolerance ", settings.shadingTolerance,
+                                ": expected a number in [0, 1]"));
+    if (!(settings.tailTransmittance >= 0.0f && settings.tailTransmittance <= 1.0f))
+        throw InputError(strCat("tail transmittance ", settings.tailTransmittance,
                                 ": expected a number in [0, 1]"));
     if (!settings.background.isFinite() || settings.background.minComponent() < 0)
         throw InputError(
@@ -932,7 +987,7 @@ RasterOutput rasterize(const Groom& groom, const Camera& camera, const FragmentS
     ctx.film = &film;
 
     prepareVertices(groom, ctx.camera, settings.fiberScale, ctx.tangents, ctx.projected);
-    indexSegments(groom, ctx.firstPoint, ctx.strandOf);
+    ctx.segments = indexSegments(groom);
     ctx.tilesX = (ctx.camera.width() + kTileSize - 1) / kTileSize;
     ctx.tilesY = (ctx.camera.height() + kTileSize - 1) / kTileSize;
     ctx.tileSurfaceDepth =
@@ -969,6 +1024,8 @@ RasterOutput rasterize(const Groom& groom, const Camera& camera, const FragmentS
         st.probedSegments += r.probedSegments;
         st.smoothSegments += r.smoothSegments;
         st.fragmentsInterpolated += r.interpolated;
+        st.tailFragments += r.tailFragments;
+        st.tailVertices += r.tailVertices;
         st.invalidSamples += r.invalid;
         for (std::string& w : r.warnings)
             if (out.warnings.size() < kMaxWarnings)

@@ -201,6 +201,18 @@ TEST(CliRenderOptions, ShadingRateIsChosenOnTheCommandLine) {
     r = test::runHairvox("render " + quoted(file) + " --shading-tolerance 0.1");
     EXPECT_NE(r.exitCode, 0);
     EXPECT_TRUE(contains(r.output, "--shading-tolerance applies to the adaptive")) << r.output;
+    // The tail: reported when it interpolates anything, refused at the vertex rate.
+    r = test::runHairvox("render " + quoted(file) + " --tail-transmittance 0.5");
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_TRUE(contains(r.output, "seen through transmittance < 0.5 interpolated from"))
+        << r.output;
+    r = test::runHairvox("render " + quoted(file) + " --shading-rate vertex --tail-transmittance 0.1");
+    EXPECT_NE(r.exitCode, 0);
+    EXPECT_TRUE(contains(r.output, "--tail-transmittance applies to the fragment and adaptive"))
+        << r.output;
+    r = test::runHairvox("render " + quoted(file) + " --tail-transmittance 2");
+    EXPECT_NE(r.exitCode, 0);
+    EXPECT_TRUE(contains(r.output, "--tail-transmittance")) << r.output;
 }
 
 TEST(CliRenderOptions, ExrCompressionIsChosenOnTheCommandLine) {

@@ -132,6 +132,26 @@ TEST(Scene, ShadingToleranceBelongsToTheAdaptiveRate) {
     EXPECT_NE(errorOf(j).find("adaptive shading rate only"), std::string::npos) << errorOf(j);
 }
 
+TEST(Scene, TailTransmittanceBelongsToTheFragmentAndAdaptiveRates) {
+    nlohmann::json j = validScene();
+    EXPECT_FLOAT_EQ(parseScene(j, "scene.json", "/").tailTransmittance,
+                    kDefaultTailTransmittance);
+    j["tail_transmittance"] = 0;
+    EXPECT_FLOAT_EQ(parseScene(j, "scene.json", "/").tailTransmittance, 0.0f);
+    j["shading_rate"] = "adaptive";
+    j["tail_transmittance"] = 0.125;
+    EXPECT_FLOAT_EQ(parseScene(j, "scene.json", "/").tailTransmittance, 0.125f);
+    for (const nlohmann::json& bad : {nlohmann::json(1.5), nlohmann::json(-0.1),
+                                      nlohmann::json("0.1"), nlohmann::json::array()}) {
+        j["tail_transmittance"] = bad;
+        EXPECT_NE(errorOf(j).find("/tail_transmittance"), std::string::npos) << errorOf(j);
+    }
+    j["shading_rate"] = "vertex";
+    j["tail_transmittance"] = 0.1;
+    EXPECT_NE(errorOf(j).find("fragment and adaptive shading rates"), std::string::npos)
+        << errorOf(j);
+}
+
 TEST(Scene, DirectionalLightPointsTowardTheLightAndIsNormalised) {
     nlohmann::json j = validScene();
     j["lights"][0]["direction"] = {0, 0, 2};

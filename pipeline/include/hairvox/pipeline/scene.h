@@ -125,6 +125,8 @@ struct Scene {
     ExactSettings exact;
     ShadingRate shadingRate = ShadingRate::Fragment;
     float shadingTolerance = kDefaultShadingTolerance; ///< the adaptive rate's τ, [0, 1]
+    /// T_tail of the fragment and adaptive rates, [0, 1] (render/fragment_shader.h)
+    float tailTransmittance = kDefaultTailTransmittance;
     Rgb background{0.0f}; ///< radiance behind everything, each channel in [0, 1e6]
     OutputSettings output;
 

@@ -29,6 +29,14 @@
 //    slowly along the fiber — and otherwise each fragment is shaded.
 // In every mode the shading tangent is the vertex tangents interpolated along
 // the segment, so the modes differ only in where the shader is evaluated.
+//
+// The tail: at the fragment and adaptive rates, hair seen through less than
+// the tail transmittance T_tail — the fragments composited once a pixel's
+// transmittance in front of them has fallen below T_tail — interpolates its
+// segment's two vertex results, as at the vertex rate, instead of being
+// shaded. Those fragments' weights sum to at most T_tail in every pixel, so
+// the change to a pixel is at most T_tail times the interpolation's error
+// there; in dense hair they are a third of the visible fragments.
 #pragma once
 
 #include <hairvox/core/enum_names.h>
@@ -52,6 +60,8 @@ inline constexpr EnumNames<ShadingRate, 3> kShadingRateNames{{{
 
 /// The adaptive rate's τ by default (docs/scene.md: image error and savings).
 inline constexpr float kDefaultShadingTolerance = 0.05f;
+/// T_tail by default (docs/scene.md: image error and savings).
+inline constexpr float kDefaultTailTransmittance = 1.0f / 16.0f;
 inline const char* toString(ShadingRate rate) {
     return kShadingRateNames.name(rate);
 }

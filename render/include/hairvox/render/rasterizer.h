@@ -82,6 +82,10 @@ struct RasterSettings {
     /// A pixel is opaque once its transmittance is ≤ this: fragments behind it
     /// are skipped. Their share of the pixel is at most this value. [0, 1)
     float opaqueTransmittance = 1.0f / 256.0f;
+    /// Fragment and adaptive rates: hair seen through less than this
+    /// transmittance interpolates strand-vertex results instead of being
+    /// shaded (fragment_shader.h); at most this share of a pixel. 0: none. [0, 1]
+    float tailTransmittance = kDefaultTailTransmittance;
     int threads = 0;       ///< 0: all cores
     bool progress = false; ///< draw a progress bar on stderr (the caller checks it is a terminal)
 };
@@ -108,6 +112,10 @@ struct RasterStats {
     /// smooth, and the hair fragments that interpolated them instead of being
     /// shaded.
     std::uint64_t probedSegments = 0, smoothSegments = 0, fragmentsInterpolated = 0;
+    /// Fragment and adaptive rates: hair fragments behind the tail
+    /// transmittance (interpolated, and counted in fragmentsInterpolated too),
+    /// and the strand vertices shaded for them.
+    std::uint64_t tailFragments = 0, tailVertices = 0;
     std::uint64_t invalidSamples = 0;      ///< shader results rejected (NaN, Inf, negative)
     std::uint64_t tiles = 0;
 };
