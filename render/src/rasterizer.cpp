@@ -11,6 +11,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <chrono>
 #include <cmath>
@@ -484,6 +485,10 @@ private:
             s_.order[i] = static_cast<std::uint32_t>(s_.keys[i]);
         s_.pixels.assign(area_, PixelState{});
         openPixels_ = area_;
+        const std::uint32_t fullRow =
+            width_ == kTileSize ? ~std::uint32_t(0) : (std::uint32_t(1) << width_) - 1;
+        openRows_.fill(0);
+        std::fill_n(openRows_.begin(), y1_ - y0_, fullRow);
         s_.pending.clear();
         s_.visible.clear();
         s_.tail.clear();
@@ -496,6 +501,27 @@ private:
                     s_.pending.push_back({ctx_.surfaces.depth[i], ctx_.surfaces.coverage[i], 0,
                                           kSurfaceFragment, pixelIndex(x, y)});
             }
+    }
+
+    /// Whether any pixel of the ribbon's bounding box in the tile is open: a
+    /// segment wholly behind opaque pixels is skipped before its coverage.
+    bool anyOpenUnder(const ScreenRibbon& r) const {
+        const auto clampTo = [](double v, int lo, int hi) {
+            return static_cast<int>(std::clamp(v, double(lo), double(hi)));
+        };
+        const int xb = clampTo(std::floor(r.xMin), x0_, x1_) - x0_;
+        const int xe = clampTo(std::ceil(r.xMax), x0_, x1_) - x0_;
+        const int yb = clampTo(std::floor(r.yMin), y0_, y1_) - y0_;
+        const int ye = clampTo(std::ceil(r.yMax), y0_, y1_) - y0_;
+        if (xb >= xe)
+            return false;
+        const std::uint32_t columns = (xe - xb == 32 ? ~std::uint32_t(0)
+                                                     : (std::uint32_t(1) << (xe - xb)) - 1)
+                                      << xb;
+        for (int y = yb; y < ye; ++y)
+            if (openRows_[std::size_t(y)] & columns)
+                return true;
+        return false;
     }
 
     void rasterizeAndComposite() {
@@ -515,6 +541,10 @@ private:
             for (std::size_t j = begin; j < end; ++j) {
                 const std::uint32_t local = s_.order[j];
                 const ScreenRibbon& r = s_.ribbons[local];
+                if (!anyOpenUnder(r)) {
+                    ++result_.segmentsSkipped;
+                    continue;
+                }
                 raster::rasterizeRibbon(
                     r, x0_, y0_, x1_, y1_,
                     [&](int x, int y, float coverage) {
@@ -614,6 +644,8 @@ private:
         if (st.T <= ctx_.settings.opaqueTransmittance) {
             st.closed = true;
             --openPixels_;
+            openRows_[f.pixel / std::uint32_t(width_)] &=
+                ~(std::uint32_t(1) << (f.pixel % std::uint32_t(width_)));
         }
     }
 
@@ -921,6 +953,8 @@ private:
     std::uint32_t area_;
     std::span<const std::uint32_t> bins_;
     std::size_t openPixels_ = 0;
+    /// Per row of the tile, bit x − x0 set while that pixel is open.
+    std::array<std::uint32_t, kTileSize> openRows_{};
     /// Hair behind this transmittance is interpolated from strand vertices
     /// (none at vertex rate: everything is).
     float tailTransmittance_ = 0;

@@ -36,7 +36,9 @@ public:
     GlobalTermStats evaluate(std::span<const GlobalTermQuery> queries,
                              std::span<GlobalTerm> out) const override {
         // Per query: the sample at or below it (an index into `samples`) and
-        // the fraction toward the next one, which is the sample after it.
+        // the fraction toward the next one, which is the sample after it; a
+        // query on a sample (f = 0: a strand vertex, as the vertex rate and
+        // the tail shade) needs that sample alone.
         struct Where {
             std::uint32_t sample;
             float f;
@@ -64,31 +66,33 @@ public:
                 ratio > 1.0f ? static_cast<int>(std::min(std::ceil(ratio), float(1 << 30))) : 1;
             const float scale = length2 > 0 ? float(m) / length2 : 0.0f;
             std::size_t end = i;
-            int kMin = m, kMax = 0;
+            int kMin = m, kMax = 0; // the first and last sample needed
             for (;
                  end < queries.size() && queries[end].segment == q.segment && queries[end].onFiber;
                  ++end) {
                 const float along = glm::dot(queries[end].position - p0, d) * scale;
                 const float x = along > 0 ? std::min(along, float(m)) : 0.0f; // NaN → 0
-                const int k = std::min(static_cast<int>(x), m - 1);
+                const int k = static_cast<int>(x);
                 where[end] = {static_cast<std::uint32_t>(k), x - float(k)};
                 kMin = std::min(kMin, k);
-                kMax = std::max(kMax, k);
+                kMax = std::max(kMax, where[end].f > 0 ? k + 1 : k);
             }
-            // The samples k, k + 1 the run needs: all of kMin ... kMax + 1
-            // when the queries lie dense along the segment (the common case:
-            // several fragments per sample), else just those (a long segment
-            // seen from afar: at most two per query). Either way a query's
-            // value depends only on its own position, not on the batch.
+            // The samples the run needs: all of kMin ... kMax when the
+            // queries lie dense along the segment (the common case: several
+            // fragments per sample), else just each query's k and, between
+            // samples, k + 1 (a long segment seen from afar). Either way a
+            // query's value depends only on its own position, not on the
+            // batch.
             needed.clear();
-            const bool dense = std::size_t(kMax - kMin + 2) <= 2 * (end - i);
+            const bool dense = std::size_t(kMax - kMin + 1) <= 2 * (end - i);
             if (dense) {
-                for (int k = kMin; k <= kMax + 1; ++k)
+                for (int k = kMin; k <= kMax; ++k)
                     needed.push_back(k);
             } else {
                 for (std::size_t j = i; j < end; ++j) {
                     needed.push_back(static_cast<int>(where[j].sample));
-                    needed.push_back(static_cast<int>(where[j].sample) + 1);
+                    if (where[j].f > 0)
+                        needed.push_back(static_cast<int>(where[j].sample) + 1);
                 }
                 std::sort(needed.begin(), needed.end());
                 needed.erase(std::unique(needed.begin(), needed.end()), needed.end());

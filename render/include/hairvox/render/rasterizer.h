@@ -100,11 +100,13 @@ struct RasterStats {
     std::uint64_t segmentTileRefs = 0;     ///< (segment, tile) pairs binned
     /// (segment, tile) pairs culled: the segment lies behind a tile wholly covered by surfaces.
     std::uint64_t segmentTilesBehindSurfaces = 0;
-    std::uint64_t segmentTilesSkipped =
-        0;                       ///< of those binned, skipped: the tile was already opaque
+    /// Of those binned, skipped whole: every pixel under the segment's
+    /// bounding box in the tile was already opaque.
+    std::uint64_t segmentTilesSkipped = 0;
     std::uint64_t fragments = 0; ///< hair (segment, pixel) pairs met
     /// Of those, skipped behind an opaque pixel (never shaded; counted per
-    /// pixel of the ribbon's row span, coverage not computed).
+    /// pixel of the ribbon's row span, coverage not computed; a segment-tile
+    /// skipped whole counts none).
     std::uint64_t fragmentsBehindOpaque = 0;
     std::uint64_t fragmentsComposited = 0; ///< hair fragments that reached the pixel
     std::uint64_t shadingPoints = 0;       ///< points handed to the shader
