@@ -109,7 +109,7 @@ void addBenchCommand(CLI::App& app) {
                     "Scene JSON file(s) to sweep instead of the default set (repeatable)");
     cmd->add_option("-o,--out", opt->out, "Output directory (results.csv, results.md, PNG plots)");
     cmd->add_flag("--quick", opt->quick,
-                  "A representative subset, 4-7 minutes on a 2-core machine: 2 scenes at 512², 3 "
+                  "A representative subset, 3-7 minutes on a 2-core machine: 2 scenes at 512², 3 "
                   "voxel sizes, fragment shading, 1 run each; the model sweep at 128², 64 spp; "
                   "a short scaling sweep");
     cmd->add_option("--threads", opt->threads, "Worker threads (0: all cores)")

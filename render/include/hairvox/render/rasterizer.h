@@ -18,7 +18,9 @@
 // mode and the path tracer meet. A pixel is opaque once its transmittance falls to
 // RasterSettings::opaqueTransmittance: fragments behind it are never shaded,
 // and since segments are rasterized nearest first, most of them are not even
-// generated (docs/DESIGN.md §7).
+// generated (docs/DESIGN.md §7). Hair seen through less than
+// RasterSettings::tailTransmittance is interpolated from its strand vertices
+// instead of being shaded (the tail, fragment_shader.h).
 //
 // Opaque surfaces (the head, meshes) are not drawn here: the caller gives
 // them as a SurfaceLayer — per pixel the coverage, depth and radiance of what
