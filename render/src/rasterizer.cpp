@@ -954,6 +954,7 @@ private:
     std::span<const std::uint32_t> bins_;
     std::size_t openPixels_ = 0;
     /// Per row of the tile, bit x − x0 set while that pixel is open.
+    static_assert(kTileSize <= 32, "a tile row's open pixels are one 32-bit mask");
     std::array<std::uint32_t, kTileSize> openRows_{};
     /// Hair behind this transmittance is interpolated from strand vertices
     /// (none at vertex rate: everything is).
