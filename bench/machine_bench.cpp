@@ -1,5 +1,5 @@
 // What this machine can do at most: the ceilings of the roofline estimate in
-// docs/roofline.md, measured here rather than taken from a data sheet (a
+// docs/DESIGN.md §7, measured here rather than taken from a data sheet (a
 // cloud VM's clock, memory and vector units are whatever the host gives it).
 //
 // Printed figures (never asserted):
@@ -8,9 +8,10 @@
 //   BM_DependentLoad      a pointer chase through a random cycle of 256 MiB: the
 //                         latency of one cache miss (ns_per_load), 1 chain and
 //                         8 independent chains (what overlapping misses buys)
-//   BM_PeakFma            independent fused multiply-adds, scalar double (the
-//                         baseline target's raster) and 16-wide float (AVX-512,
-//                         the shader's dispatch): FLOP/s (flops_per_second)
+//   BM_PeakFma            independent multiply-adds: scalar double, unfused (the
+//                         x86-64 baseline the raster is compiled for), and 16-wide
+//                         float FMA (AVX-512, the shader's dispatch): FLOP/s
+//                         (flops_per_second)
 //
 //   machine_bench                      # everything (≈ 20 s)
 #include <benchmark/benchmark.h>

@@ -110,6 +110,11 @@ constexpr std::size_t kPrefetchAhead = 8;
 
 inline void prefetch(const void* address) { __builtin_prefetch(address); }
 
+/// The mask of bits 0 … n − 1 (n ≤ 32).
+constexpr std::uint32_t lowBits(int n) {
+    return n >= 32 ? ~std::uint32_t(0) : (std::uint32_t(1) << n) - 1;
+}
+
 /// Everything the tiles share.
 struct RenderContext {
     const Groom& groom;
@@ -485,10 +490,8 @@ private:
             s_.order[i] = static_cast<std::uint32_t>(s_.keys[i]);
         s_.pixels.assign(area_, PixelState{});
         openPixels_ = area_;
-        const std::uint32_t fullRow =
-            width_ == kTileSize ? ~std::uint32_t(0) : (std::uint32_t(1) << width_) - 1;
         openRows_.fill(0);
-        std::fill_n(openRows_.begin(), y1_ - y0_, fullRow);
+        std::fill_n(openRows_.begin(), y1_ - y0_, lowBits(width_));
         s_.pending.clear();
         s_.visible.clear();
         s_.tail.clear();
@@ -515,9 +518,7 @@ private:
         const int ye = clampTo(std::ceil(r.yMax), y0_, y1_) - y0_;
         if (xb >= xe)
             return false;
-        const std::uint32_t columns = (xe - xb == 32 ? ~std::uint32_t(0)
-                                                     : (std::uint32_t(1) << (xe - xb)) - 1)
-                                      << xb;
+        const std::uint32_t columns = lowBits(xe - xb) << xb;
         for (int y = yb; y < ye; ++y)
             if (openRows_[std::size_t(y)] & columns)
                 return true;
