@@ -24,6 +24,9 @@ if(HAIRVOX_SANITIZE)
         -fno-sanitize-recover=all)
     add_compile_options(${HAIRVOX_SANITIZE_FLAGS})
     add_link_options(${HAIRVOX_SANITIZE_FLAGS})
+    # Storage left uninitialised for its producer to fill (Film::Init) is
+    # filled with NaN instead, so that a value left unwritten fails the tests.
+    add_compile_definitions(HAIRVOX_POISON_UNINITIALIZED=1)
 endif()
 
 # Apply hairvox's warning set to one of its own targets (never to dependencies).

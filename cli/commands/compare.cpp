@@ -93,7 +93,8 @@ void runCompare(const CompareOptions& opt) {
                 return ComparedImage::fromFilm(film, opt.layers, opt.mask);
             if (opt.what == "hair") {
                 ComparedImage image = hairRadianceOf(film);
-                image.mask = film.layer(opt.mask).data;
+                const auto& mask = film.layer(opt.mask).data;
+                image.mask.assign(mask.begin(), mask.end());
                 return image;
             }
             return ComparedImage::beautyOf(film, opt.mask);

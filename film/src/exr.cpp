@@ -1,6 +1,7 @@
 #include <hairvox/core/atomic_file.h>
 #include <hairvox/core/error.h>
 #include <hairvox/core/interrupt.h>
+#include <hairvox/core/large_array.h>
 #include <hairvox/core/parallel.h>
 #include <hairvox/film/image_file.h>
 
@@ -72,8 +73,8 @@ public:
     /// Converts rows [y0, y0 + rows) into the band buffers and points `file` at them.
     void setBand(Imf::OutputFile& file, int y0, int rows) {
         const std::size_t capacity = width_ * std::size_t(kBandRows);
-        if (!band_) // written before read: no need to zero it
-            band_ = std::make_unique_for_overwrite<std::uint32_t[]>(channels_.size() * capacity);
+        if (band_.empty()) // written before read: left unwritten by resize
+            band_.resize(channels_.size() * capacity);
         const std::size_t count = width_ * std::size_t(rows);
         // Channels × blocks of rows, converted on the calling threads while
         // OpenEXR's pool waits for the band.
@@ -84,7 +85,7 @@ public:
             const std::size_t begin = (task % blocks) * kRowsPerTask * width_;
             const std::size_t n = std::min(count, begin + kRowsPerTask * width_) - begin;
             const float* src = c.first + (std::size_t(y0) * width_ + begin) * c.stride;
-            std::uint32_t* dst = band_.get() + (task / blocks) * capacity;
+            std::uint32_t* dst = band_.data() + (task / blocks) * capacity;
             if (c.half)
                 detail::toHalf(src, c.stride, n, reinterpret_cast<std::uint16_t*>(dst) + begin);
             else
@@ -94,7 +95,7 @@ public:
         Imf::FrameBuffer frameBuffer;
         for (std::size_t i = 0; i < channels_.size(); ++i) {
             const ExrChannel& c = channels_[i];
-            char* band = reinterpret_cast<char*>(band_.get() + i * capacity);
+            char* band = reinterpret_cast<char*>(band_.data() + i * capacity);
             // The band's first value is pixel (0, y0).
             frameBuffer.insert(c.name,
                                Imf::Slice::Make(c.half ? Imf::HALF : Imf::FLOAT, band,
@@ -107,7 +108,7 @@ private:
     std::size_t width_, pixels_;
     std::vector<ExrChannel> channels_;
     /// One band: per channel kBandRows rows of halves or floats (4 bytes reserved per value).
-    std::unique_ptr<std::uint32_t[]> band_;
+    LargeVector<std::uint32_t> band_;
 };
 
 } // namespace
@@ -225,7 +226,7 @@ Film filmFromExr(const ExrImage& image) {
             }
             continue;
         }
-        film.layer(film.addLayer(name, 1, true)).data = values;
+        film.layer(film.addLayer(name, 1, true)).data.assign(values.begin(), values.end());
     }
     return film;
 }

@@ -1,6 +1,7 @@
 #include <hairvox/core/error.h>
 #include <hairvox/film/film.h>
 
+#include <limits>
 #include <stdexcept>
 
 namespace hairvox {
@@ -12,7 +13,7 @@ Film::Film(int width, int height)
         throw std::invalid_argument(strCat("Film: size ", width, " x ", height));
 }
 
-std::size_t Film::addLayer(std::string name, int channels, bool fullPrecision) {
+std::size_t Film::addLayer(std::string name, int channels, bool fullPrecision, Init init) {
     if (channels != 1 && channels != 3)
         throw std::invalid_argument(
             strCat("Film: layer '", name, "' with ", channels, " channels"));
@@ -22,7 +23,15 @@ std::size_t Film::addLayer(std::string name, int channels, bool fullPrecision) {
     l.name = std::move(name);
     l.channels = channels;
     l.fullPrecision = fullPrecision;
-    l.data.assign(pixelCount() * std::size_t(channels), 0.0f);
+    const std::size_t size = pixelCount() * std::size_t(channels);
+#ifdef HAIRVOX_POISON_UNINITIALIZED
+    l.data.assign(size, init == Init::Zero ? 0.0f : std::numeric_limits<float>::quiet_NaN());
+#else
+    if (init == Init::Zero)
+        l.data.assign(size, 0.0f);
+    else
+        l.data.resize(size);
+#endif
     layers_.push_back(std::move(l));
     return layers_.size() - 1;
 }

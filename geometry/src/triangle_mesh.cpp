@@ -61,16 +61,23 @@ namespace {
 /// The lines of an OBJ text that tinyobjloader would misread, checked before
 /// it reads them: coordinates that are not finite numbers and face indices
 /// out of range (tinyobjloader turns "nan" into 0 and keeps such indices).
+/// The coordinates of `v` and `vn` lines are kept as parsed here, correctly
+/// rounded (std::from_chars): tinyobjloader's own number parser accumulates
+/// digits in a double, so a long number such as 1 followed by 400 zeros and
+/// "e-399" reads as infinity and 0.(400 zeros)1e400 as 0 (found by fuzz_mesh).
+/// tinyobjloader supplies the faces only.
 class ObjValidator {
 public:
     explicit ObjValidator(const std::string& name) : name_(name) {}
 
+    std::vector<Vec3f> positions, normals;
+
     void line(std::string_view text, std::size_t number) {
         text = trim(text);
         if (text.starts_with("v ") || text.starts_with("v\t"))
-            vertex(text.substr(2), number, positions_);
+            positions.push_back(vertex(text.substr(2), number));
         else if (text.starts_with("vn ") || text.starts_with("vn\t"))
-            vertex(text.substr(3), number, normals_);
+            normals.push_back(vertex(text.substr(3), number));
         else if (text.starts_with("vt ") || text.starts_with("vt\t"))
             ++texcoords_;
         else if (text.starts_with("f ") || text.starts_with("f\t"))
@@ -96,7 +103,8 @@ private:
         throw InputError(strCat(name_, ": line ", number, ": ", what));
     }
 
-    void vertex(std::string_view rest, std::size_t number, std::uint64_t& count) {
+    Vec3f vertex(std::string_view rest, std::size_t number) {
+        Vec3f v;
         for (int k = 0; k < 3; ++k) {
             const std::string_view token = nextToken(rest);
             double value = 0;
@@ -105,8 +113,9 @@ private:
                 !std::isfinite(value) || std::abs(value) > double(std::numeric_limits<float>::max()))
                 fail(number, strCat("coordinate ", k + 1, " is \"", token,
                                     "\": expected a finite number"));
+            v[k] = static_cast<float>(value);
         }
-        ++count;
+        return v;
     }
 
     /// One index of a face corner: 1-based, or negative (relative to the end).
@@ -126,7 +135,7 @@ private:
         for (std::string_view token = nextToken(rest); !token.empty(); token = nextToken(rest)) {
             ++corners;
             const std::size_t s1 = token.find('/');
-            index(token.substr(0, s1), positions_, "vertex", number);
+            index(token.substr(0, s1), positions.size(), "vertex", number);
             if (s1 == std::string_view::npos)
                 continue;
             const std::string_view after = token.substr(s1 + 1);
@@ -134,19 +143,20 @@ private:
             if (const std::string_view t = after.substr(0, s2); !t.empty())
                 index(t, texcoords_, "texture coordinate", number);
             if (s2 != std::string_view::npos)
-                index(after.substr(s2 + 1), normals_, "normal", number);
+                index(after.substr(s2 + 1), normals.size(), "normal", number);
         }
         if (corners < 3)
             fail(number, strCat("a face needs at least 3 corners, this one has ", corners));
     }
 
     const std::string& name_;
-    std::uint64_t positions_ = 0, normals_ = 0, texcoords_ = 0;
+    std::uint64_t texcoords_ = 0;
 };
 
-/// Lines end at '\n' or '\r' as tinyobjloader splits them (a lone '\r' too);
-/// messages count '\n' lines.
-void validateObjText(std::string_view text, const std::string& name) {
+/// Checks every line (they end at '\n' or '\r' as tinyobjloader splits
+/// them, a lone '\r' too; messages count '\n' lines) and returns the
+/// validator with the positions and normals it parsed.
+ObjValidator validateObjText(std::string_view text, const std::string& name) {
     ObjValidator validator(name);
     std::size_t number = 1;
     for (std::size_t start = 0; start < text.size();) {
@@ -156,12 +166,20 @@ void validateObjText(std::string_view text, const std::string& name) {
             ++number;
         start = end + 1;
     }
+    return validator;
+}
+
+/// A unit normal from a finite vector of any magnitude (scaled first, so that
+/// components near FLT_MAX do not overflow its length), or `fallback`.
+Vec3f unitNormalOr(const Vec3f& n, const Vec3f& fallback) {
+    const float largest = std::max({std::abs(n.x), std::abs(n.y), std::abs(n.z)});
+    return largest > 0 ? normalizeOr(n / largest, fallback) : fallback;
 }
 
 } // namespace
 
 LoadedMesh parseObjMesh(std::string_view text, const std::string& name) {
-    validateObjText(text, name);
+    ObjValidator parsed = validateObjText(text, name);
     tinyobj::ObjReaderConfig config;
     config.triangulate = false; // fanned below, so that a face stays one face
     config.vertex_color = false;
@@ -170,25 +188,23 @@ LoadedMesh parseObjMesh(std::string_view text, const std::string& name) {
         throw InputError(strCat(name, ": ", reader.Error()));
     const tinyobj::attrib_t& attrib = reader.GetAttrib();
 
-    LoadedMesh out;
-    TriangleMesh& mesh = out.mesh;
-    const std::size_t vertexCount = attrib.vertices.size() / 3;
-    mesh.positions.resize(vertexCount);
-    for (std::size_t i = 0; i < vertexCount; ++i)
-        mesh.positions[i] = Vec3f(attrib.vertices[3 * i], attrib.vertices[3 * i + 1],
-                                  attrib.vertices[3 * i + 2]);
     // The check above makes every index valid; this guards against the two
     // parsers ever disagreeing about a line.
     const auto inconsistent = [&] {
         return InputError(strCat(name, ": a face index names no vertex or normal"));
     };
+    if (attrib.vertices.size() != 3 * parsed.positions.size() ||
+        attrib.normals.size() != 3 * parsed.normals.size())
+        throw inconsistent();
+
+    LoadedMesh out;
+    TriangleMesh& mesh = out.mesh;
+    mesh.positions = std::move(parsed.positions);
+    const std::size_t vertexCount = mesh.positions.size();
     const auto normalAt = [&](int index) {
         if (index < 0)
             return Vec3f(0.0f);
-        const auto k = static_cast<std::size_t>(index);
-        if (3 * k + 2 >= attrib.normals.size())
-            throw inconsistent();
-        return Vec3f(attrib.normals[3 * k], attrib.normals[3 * k + 1], attrib.normals[3 * k + 2]);
+        return parsed.normals[static_cast<std::size_t>(index)];
     };
 
     std::uint64_t degenerate = 0, withoutNormals = 0, corners = 0;
@@ -210,19 +226,22 @@ LoadedMesh parseObjMesh(std::string_view text, const std::string& name) {
                                                      static_cast<std::uint32_t>(c[2].vertex_index)};
                 const Vec3f& a = mesh.positions[t[0]];
                 const Vec3f area = glm::cross(mesh.positions[t[1]] - a, mesh.positions[t[2]] - a);
-                if (!(glm::dot(area, area) > 0)) {
+                if (!isFinite(area))
+                    throw InputError(strCat(name, ": a triangle's edges overflow single precision "
+                                                  "(coordinates near ±3.4e38): not a usable mesh"));
+                if (area == Vec3f(0.0f)) {
                     ++degenerate;
                     continue;
                 }
                 if (mesh.triangles.size() >= kMaxMeshTriangles)
                     throw InputError(strCat(name, ": more than ", kMaxMeshTriangles, " triangles"));
                 mesh.triangles.push_back(t);
-                const Vec3f geometric = glm::normalize(area);
+                const Vec3f geometric = unitNormalOr(area, Vec3f(0.0f, 0.0f, 1.0f));
                 for (const tinyobj::index_t& corner : c) {
                     const Vec3f n = normalAt(corner.normal_index);
                     withoutNormals += corner.normal_index < 0 ? 1u : 0u;
                     ++corners;
-                    mesh.cornerNormals.push_back(normalizeOr(n, geometric));
+                    mesh.cornerNormals.push_back(unitNormalOr(n, geometric));
                 }
             }
         }

@@ -74,7 +74,7 @@ void warnIfNoHairSeen(const Scene& scene, const Film& film, const Groom* groom,
     const auto hair = film.find(kHairAlphaLayer);
     if (!hair || film.pixelCount() == 0)
         return;
-    const std::vector<float>& a = film.layer(*hair).data;
+    const auto& a = film.layer(*hair).data;
     if (std::any_of(a.begin(), a.end(), [](float x) { return x > 0; }))
         return;
     std::string bounds;

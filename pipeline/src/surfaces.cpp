@@ -1,5 +1,6 @@
 #include "surfaces.h"
 
+#include <hairvox/core/large_array.h>
 #include <hairvox/core/interrupt.h>
 #include <hairvox/core/math.h>
 
@@ -20,13 +21,15 @@ constexpr int kQuadrant = kEdgeSamples / 2;
 constexpr float kSmoothDepthRatio = 1.02f; ///< corners this close in depth: one smooth surface
 constexpr std::uint32_t kMiss = std::numeric_limits<std::uint32_t>::max();
 
-/// Where the camera ray through a raster position meets the surfaces.
+/// Where the camera ray through a raster position meets the surfaces. No
+/// member initialisers (castView() sets every member), so that the samples'
+/// LargeVector is not written before the rows' samples are copied in.
 struct ViewSample {
-    std::uint32_t surface = kMiss;
-    float depth = 0;         ///< camera-space z
-    Vec3f position{0.0f};
-    Vec3f normal{0.0f};      ///< shading, facing the camera
-    Vec3f geometricNormal{0.0f};
+    std::uint32_t surface; ///< kMiss where the ray met nothing
+    float depth;           ///< camera-space z
+    Vec3f position;
+    Vec3f normal;          ///< shading, facing the camera
+    Vec3f geometricNormal;
 };
 
 ViewSample castView(const SurfaceScene& surfaces, const Camera& camera, const Vec2f& raster) {
@@ -35,7 +38,7 @@ ViewSample castView(const SurfaceScene& surfaces, const Camera& camera, const Ve
     // Geometry nearer than the near plane is clipped, as for the hair.
     const float tNear = camera.nearClip() / dirCam.z;
     const Vec3f origin = camera.position() + tNear * dir;
-    ViewSample s;
+    ViewSample s{kMiss, 0.0f, Vec3f(0.0f), Vec3f(0.0f), Vec3f(0.0f)};
     if (const std::optional<SurfaceHit> hit =
             surfaces.intersect(origin, dir, std::numeric_limits<float>::infinity())) {
         s.surface = hit->surface;
@@ -47,10 +50,12 @@ ViewSample castView(const SurfaceScene& surfaces, const Camera& camera, const Ve
     return s;
 }
 
-/// What a pixel-corner ray met (8 bytes: one per pixel of the image).
+/// What a pixel-corner ray met (8 bytes: one per pixel of the image). No
+/// member initialisers: a LargeVector of them is left unwritten until
+/// the rays fill it.
 struct CornerHit {
-    std::uint32_t surface = kMiss;
-    float depth = 0;
+    std::uint32_t surface;
+    float depth;
 };
 
 /// A point to shade and the share of its pixel's surface radiance it stands for.
@@ -68,15 +73,21 @@ SurfaceLayer surfaceLayer(const SurfaceScene& surfaces, const std::vector<Rgb>& 
     const int width = camera.width(), height = camera.height();
     const std::size_t pixels = std::size_t(width) * std::size_t(height);
     SurfaceLayer layer;
-    layer.coverage.assign(pixels, 0.0f);
-    layer.depth.assign(pixels, 0.0f);
-    layer.radiance.assign(pixels, Rgb(0.0f));
-    if (surfaces.empty())
+    if (surfaces.empty()) {
+        layer.coverage.assign(pixels, 0.0f);
+        layer.depth.assign(pixels, 0.0f);
+        layer.radiance.assign(pixels, Rgb(0.0f));
         return layer;
+    }
+    // Every pixel is written by the parallel loops below (so that their
+    // threads touch the pages first, core/large_array.h).
+    layer.coverage.resize(pixels);
+    layer.depth.resize(pixels);
+    layer.radiance.assign(pixels, Rgb(0.0f)); // (Rgb's constructor writes anyway)
 
     // 1. Visibility at the pixel corners.
     const std::size_t cornerRow = std::size_t(width) + 1;
-    std::vector<CornerHit> corners(cornerRow * (std::size_t(height) + 1));
+    LargeVector<CornerHit> corners(cornerRow * (std::size_t(height) + 1));
     tbb::parallel_for(0, height + 1, [&](int y) {
         for (int x = 0; x <= width; ++x) {
             const ViewSample s = castView(surfaces, camera, Vec2f(float(x), float(y)));
@@ -106,6 +117,8 @@ SurfaceLayer surfaceLayer(const SurfaceScene& surfaces, const std::vector<Rgb>& 
                 zMin = std::min(zMin, s->depth);
                 zMax = std::max(zMax, s->depth);
             }
+            layer.coverage[p] = 0.0f;
+            layer.depth[p] = 0.0f;
             if (hits == 0)
                 continue;
             if (hits == 4 && sameSurface && zMax <= kSmoothDepthRatio * zMin) {
@@ -125,7 +138,7 @@ SurfaceLayer surfaceLayer(const SurfaceScene& surfaces, const std::vector<Rgb>& 
             for (int qy = 0; qy < 2; ++qy)
                 for (int qx = 0; qx < 2; ++qx) {
                     int quadrantHits = 0;
-                    ViewSample shaded;
+                    ViewSample shaded{};
                     for (int j = qy * kQuadrant; j < (qy + 1) * kQuadrant; ++j)
                         for (int i = qx * kQuadrant; i < (qx + 1) * kQuadrant; ++i) {
                             const ViewSample s = castView(
@@ -151,11 +164,15 @@ SurfaceLayer surfaceLayer(const SurfaceScene& surfaces, const std::vector<Rgb>& 
         }
     });
     throwIfInterrupted();
-    std::vector<ShadingSample> samples;
-    for (std::vector<ShadingSample>& row : rows) {
-        samples.insert(samples.end(), row.begin(), row.end());
-        row = {};
-    }
+    // The rows' samples laid end to end (row y's from rowStart[y]).
+    std::vector<std::size_t> rowStart(rows.size() + 1, 0);
+    for (std::size_t y = 0; y < rows.size(); ++y)
+        rowStart[y + 1] = rowStart[y] + rows[y].size();
+    LargeVector<ShadingSample> samples(rowStart.back());
+    tbb::parallel_for(std::size_t(0), rows.size(), [&](std::size_t y) {
+        std::copy(rows[y].begin(), rows[y].end(), samples.begin() + std::ptrdiff_t(rowStart[y]));
+        rows[y] = {};
+    });
 
     // 3. Lambertian radiance lit through the hair, light by light.
     std::vector<Rgb> radiance(samples.size(), Rgb(0.0f));
@@ -196,8 +213,11 @@ SurfaceLayer surfaceLayer(const SurfaceScene& surfaces, const std::vector<Rgb>& 
             });
         throwIfInterrupted();
     }
-    for (std::size_t i = 0; i < samples.size(); ++i)
-        layer.radiance[samples[i].pixel] += samples[i].weight * radiance[i];
+    // Row by row: a row's samples are its pixels'.
+    tbb::parallel_for(0, height, [&](int y) {
+        for (std::size_t i = rowStart[std::size_t(y)]; i < rowStart[std::size_t(y) + 1]; ++i)
+            layer.radiance[samples[i].pixel] += samples[i].weight * radiance[i];
+    });
     return layer;
 }
 

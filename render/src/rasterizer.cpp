@@ -1,5 +1,6 @@
 #include "ribbon.h"
 
+#include <hairvox/core/large_array.h>
 #include <hairvox/core/error.h>
 #include <hairvox/core/interrupt.h>
 #include <hairvox/core/math.h>
@@ -42,8 +43,9 @@ double secondsSince(Clock::time_point start) {
 /// adjacent segments' directions), and every point's projection with its
 /// ribbon half-width k·D_i/2 (ribbonWidthAt()).
 void prepareVertices(const Groom& groom, const Camera& camera, const FiberScale& scale,
-                     std::vector<Vec3f>& tangents,
-                     std::vector<raster::ProjectedVertex>& projected) {
+                     LargeVector<Vec3f>& tangents,
+                     LargeVector<raster::ProjectedVertex>& projected) {
+    // Left unwritten here, filled strand by strand below on the threads.
     tangents.resize(groom.pointCount());
     projected.resize(groom.pointCount());
     tbb::parallel_for(
@@ -125,8 +127,8 @@ struct RenderContext {
     const SurfaceLayer& surfaces;
     std::size_t stride;         ///< floats per shaded point
     std::size_t radianceFloats; ///< of those, the radiance layers'
-    std::vector<Vec3f> tangents;
-    std::vector<raster::ProjectedVertex> projected; ///< per point
+    LargeVector<Vec3f> tangents;
+    LargeVector<raster::ProjectedVertex> projected; ///< per point
     std::vector<SegmentRef> segments; ///< per segment
     int tilesX = 0, tilesY = 0;
     /// Per tile: the farthest surface depth if surfaces cover every pixel wholly, else +∞.
@@ -919,14 +921,15 @@ private:
     }
 
     /// Radiance layers get the premultiplied sums (and add to the beauty);
-    /// average layers the sums divided by the hair's weight.
+    /// average layers the sums divided by the hair's weight, 0 without hair.
+    /// Every pixel of the tile is written: the shader's layers are allocated
+    /// uninitialised (Film::Init::Uninitialized).
     void finishShading() {
         float* beauty = film_.layer(ctx_.beautyLayer).data.data();
         for (std::uint32_t p = 0; p < area_; ++p) {
             const float w = s_.pixels[p].hairWeight;
-            if (!(w > 0))
-                continue;
             const std::size_t i = filmIndex(p);
+            // Zero where no fragment was shaded: nothing accumulated.
             const float* sum = s_.pixelSum.data() + std::size_t(p) * stride_;
             for (std::size_t l = 0; l < ctx_.radianceLayer.size(); ++l) {
                 float* layer = film_.layer(ctx_.radianceLayer[l]).data.data() + 3 * i;
@@ -935,7 +938,7 @@ private:
                     beauty[3 * i + c] += sum[3 * l + c];
                 }
             }
-            const float invW = 1.0f / w;
+            const float invW = w > 0 ? 1.0f / w : 0.0f;
             std::size_t k = ctx_.radianceFloats;
             for (std::size_t l = 0; l < ctx_.averageLayer.size(); ++l) {
                 FilmLayer& layer = film_.layer(ctx_.averageLayer[l]);
@@ -1010,16 +1013,19 @@ RasterOutput rasterize(const Groom& groom, const Camera& camera, const FragmentS
     RasterOutput out;
     out.film = Film(camera.width(), camera.height());
     Film& film = out.film;
-    ctx.beautyLayer = film.addLayer(std::string(Film::kBeauty), 3);
-    ctx.alphaLayer = film.addLayer(std::string(Film::kAlpha), 1);
+    // Every layer's pixels are written by their tile (finishCoverage(),
+    // finishShading()), so the film's pages are first touched there.
+    constexpr Film::Init tileWritten = Film::Init::Uninitialized;
+    ctx.beautyLayer = film.addLayer(std::string(Film::kBeauty), 3, false, tileWritten);
+    ctx.alphaLayer = film.addLayer(std::string(Film::kAlpha), 1, false, tileWritten);
     for (const std::string& name : ctx.layout.radiance)
-        ctx.radianceLayer.push_back(film.addLayer(name, 3));
-    ctx.surfaceLayer = film.addLayer(kSurfaceLayer, 3);
-    ctx.backgroundLayer = film.addLayer(kBackgroundLayer, 3);
-    ctx.hairAlphaLayer = film.addLayer(kHairAlphaLayer, 1);
-    ctx.depthLayer = film.addLayer(kDepthLayer, 1, /*fullPrecision=*/true);
+        ctx.radianceLayer.push_back(film.addLayer(name, 3, false, tileWritten));
+    ctx.surfaceLayer = film.addLayer(kSurfaceLayer, 3, false, tileWritten);
+    ctx.backgroundLayer = film.addLayer(kBackgroundLayer, 3, false, tileWritten);
+    ctx.hairAlphaLayer = film.addLayer(kHairAlphaLayer, 1, false, tileWritten);
+    ctx.depthLayer = film.addLayer(kDepthLayer, 1, /*fullPrecision=*/true, tileWritten);
     for (const ShaderLayout::AverageLayer& a : ctx.layout.averages)
-        ctx.averageLayer.push_back(film.addLayer(a.name, a.channels));
+        ctx.averageLayer.push_back(film.addLayer(a.name, a.channels, false, tileWritten));
     ctx.film = &film;
 
     prepareVertices(groom, ctx.camera, settings.fiberScale, ctx.tangents, ctx.projected);

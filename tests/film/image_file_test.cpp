@@ -51,6 +51,16 @@ TEST(Film, LayersAreNamedOnceAndSized) {
     EXPECT_THROW(film.addLayer("z", 2), std::invalid_argument);
     EXPECT_THROW(static_cast<void>(film.layer("missing")), std::out_of_range);
     EXPECT_FALSE(film.find("missing"));
+    // A layer its producer fills: sized, zero only if asked; NaN where the
+    // sanitizer builds poison it, so that a pixel left unwritten shows.
+    const std::size_t u = film.addLayer("u", 3, false, Film::Init::Uninitialized);
+    EXPECT_EQ(film.layer(u).data.size(), 36u);
+#ifdef HAIRVOX_POISON_UNINITIALIZED
+    for (float x : film.layer(u).data)
+        EXPECT_TRUE(std::isnan(x));
+#endif
+    for (float x : film.layer("x").data)
+        EXPECT_EQ(x, 0.0f);
 }
 
 TEST(ExrFile, EveryLayerRoundTripsAtItsPrecision) {

@@ -83,6 +83,32 @@ TEST(ObjMesh, BadFilesNameTheFileAndTheLine) {
     }
 }
 
+// Coordinates are read correctly rounded, whatever their spelling: numbers
+// that tinyobjloader's own parser misreads (found by fuzz_mesh: 1 followed by
+// 400 zeros and e-399 read as infinity, 0.(400 zeros)1e400 as 0).
+TEST(ObjMesh, LongNumbersAreReadCorrectlyRounded) {
+    const std::string zeros(400, '0');
+    const LoadedMesh m = parseObjMesh("v 1" + zeros + "e-399 0 0\nv 0." + zeros +
+                                          "1e400 1 0\nv 0 0 1" + zeros + "e-400\nvn 0 0 1" +
+                                          zeros + "e-399\nf 1//1 2//1 3//1\n",
+                                      "long.obj");
+    ASSERT_EQ(m.mesh.positions.size(), 3u);
+    EXPECT_EQ(m.mesh.positions[0], Vec3f(10.0f, 0.0f, 0.0f));
+    EXPECT_EQ(m.mesh.positions[1], Vec3f(0.1f, 1.0f, 0.0f));
+    EXPECT_EQ(m.mesh.positions[2], Vec3f(0.0f, 0.0f, 1.0f));
+    ASSERT_EQ(m.mesh.cornerNormals.size(), 3u);
+    EXPECT_EQ(m.mesh.cornerNormals[0], Vec3f(0.0f, 0.0f, 1.0f));
+    // Normals as long as single precision allows still normalise.
+    const LoadedMesh big =
+        parseObjMesh("v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 3e38 3e38 0\nf 1//1 2//1 3//1\n", "big.obj");
+    for (const Vec3f& n : big.mesh.cornerNormals)
+        EXPECT_NEAR(glm::length(n), 1.0f, 1e-6f);
+    // A triangle whose edges overflow single precision is refused.
+    EXPECT_EQ(errorOf("v -3e38 0 0\nv 3e38 0 0\nv 0 3e38 0\nf 1 2 3\n"),
+              "body.obj: a triangle's edges overflow single precision (coordinates near ±3.4e38): "
+              "not a usable mesh");
+}
+
 TEST(ObjMesh, DegenerateTrianglesAreDroppedWithAWarning) {
     const LoadedMesh m = parseObjMesh(cubeObj(false) + "f 1 1 2\nf 1 2 1\n", "cube.obj");
     EXPECT_EQ(m.mesh.triangleCount(), 12u);

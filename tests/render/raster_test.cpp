@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstring>
 #include <numeric>
+#include <span>
 
 namespace hairvox {
 namespace {
@@ -20,18 +21,18 @@ using Vec2d = glm::dvec2;
 using test::testCamera;
 using test::testSettings;
 
-double sum(const std::vector<float>& v) {
+double sum(std::span<const float> v) {
     return std::accumulate(v.begin(), v.end(), 0.0,
                            [](double a, float b) { return a + double(b); });
 }
 
-const std::vector<float>& alpha(const Film& f) {
+const LargeVector<float>& alpha(const Film& f) {
     return f.layer(Film::kAlpha).data;
 }
-const std::vector<float>& hairAlpha(const Film& f) {
+const LargeVector<float>& hairAlpha(const Film& f) {
     return f.layer(kHairAlphaLayer).data;
 }
-const std::vector<float>& depth(const Film& f) {
+const LargeVector<float>& depth(const Film& f) {
     return f.layer(kDepthLayer).data;
 }
 Rgb rgb(const Film& f, std::string_view layer, std::size_t p) {

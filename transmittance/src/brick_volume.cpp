@@ -1,6 +1,7 @@
 #include "brick_volume.h"
 
 #include <hairvox/core/grid_traversal.h>
+#include <hairvox/core/large_array.h>
 
 #include <glm/common.hpp>
 
@@ -142,8 +143,8 @@ void BrickVolume::reserveBrick(const glm::ivec3& b, int lowFaces) {
             insert(b - glm::ivec3((mask >> 2) & 1, (mask >> 1) & 1, mask & 1));
 }
 
-void BrickVolume::AlignedDelete::operator()(Lanes* p) const {
-    ::operator delete[](p, std::align_val_t(alignof(Lanes)));
+void BrickVolume::LargeDelete::operator()(Lanes* p) const {
+    deallocateLarge(p, bytes, alignof(Lanes));
 }
 
 bool BrickVolume::occupied(const glm::ivec3& b) const {
@@ -204,9 +205,9 @@ void BrickVolume::allocateValues() {
     }
     // Lanes is an aggregate (an implicit-lifetime type): raw storage filled
     // with value-initialised Lanes, brick by brick on the threads.
-    values_.reset(static_cast<Lanes*>(
-        ::operator new[](std::max<std::size_t>(valueCount_, 1) * sizeof(Lanes),
-                         std::align_val_t(alignof(Lanes)))));
+    const std::size_t bytes = std::max<std::size_t>(valueCount_, 1) * sizeof(Lanes);
+    values_ = std::unique_ptr<Lanes[], LargeDelete>(
+        static_cast<Lanes*>(allocateLarge(bytes, alignof(Lanes))), LargeDelete{bytes});
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, brickCount_, 64), [&](const auto& r) {
         std::uninitialized_value_construct(values_.get() + valueBase_[r.begin()],
                                            values_.get() + valueBase_[r.end() - 1] +

@@ -199,7 +199,8 @@ private:
     std::vector<std::int64_t> slots_;  ///< open addressing: brick index per slot, −1 if free
     std::size_t brickCount_ = 0;
     std::vector<glm::ivec3> brickCoord_; ///< per brick
-    struct AlignedDelete {
+    struct LargeDelete {
+        std::size_t bytes; ///< (no initialiser: GCC would not see the deleter as default-constructible)
         void operator()(Lanes* p) const;
     };
     std::vector<SlotBits> present_; ///< per brick
@@ -208,7 +209,7 @@ private:
     /// cell holds a value: a line's walk skips the other cells on one test.
     std::vector<std::array<std::uint64_t, 8>> cellMask_;
     /// The packed values of every brick, once allocate() has run.
-    std::unique_ptr<Lanes[], AlignedDelete> values_;
+    std::unique_ptr<Lanes[], LargeDelete> values_; ///< on huge pages (core/large_array.h)
     std::size_t valueCount_ = 0;
     glm::ivec3 brickMin_{0}, brickMax_{-1};
     /// One bit per brick position of [brickMin_, brickMax_] (x fastest), set

@@ -19,6 +19,7 @@
 
 #include "brick_volume.h"
 
+#include <hairvox/core/large_array.h>
 #include <hairvox/geometry/light.h>
 
 #include <cstdint>
@@ -67,7 +68,7 @@ private:
     int i0_ = 0, j0_ = 0, ni_ = 0, nj_ = 0; ///< line lattice [i0, i0 + ni) × [j0, j0 + nj)
     std::vector<std::uint64_t> lineRuns_; ///< line l's runs are runs_[lineRuns_[l], lineRuns_[l + 1])
     std::vector<Run> runs_;               ///< and a sentinel whose begin is samples_.size()
-    std::vector<Lanes> samples_;
+    LargeVector<Lanes> samples_; ///< on huge pages: queries read it scattered
 };
 
 } // namespace hairvox::detail

@@ -10,6 +10,7 @@
 // the top (geometry/camera.h).
 #pragma once
 
+#include <hairvox/core/large_array.h>
 #include <hairvox/core/rgb.h>
 
 #include <cstddef>
@@ -27,7 +28,7 @@ struct FilmLayer {
     /// Stored as 32-bit float in files even where half would hold the values
     /// (depth: half's 11-bit mantissa is too coarse).
     bool fullPrecision = false;
-    std::vector<float> data; ///< pixelCount() × channels
+    LargeVector<float> data; ///< pixelCount() × channels
 
     Rgb rgb(std::size_t pixel) const {
         const float* p = &data[pixel * 3];
@@ -48,9 +49,21 @@ public:
         return std::size_t(y) * std::size_t(width_) + std::size_t(x);
     }
 
-    /// Adds a zeroed layer and returns its index. std::invalid_argument if the
-    /// name is taken or channels is not 1 or 3.
-    std::size_t addLayer(std::string name, int channels, bool fullPrecision = false);
+    /// What a new layer holds.
+    enum class Init {
+        Zero,
+        /// Nothing yet: its producer writes every pixel before anything reads
+        /// it, from the threads that render them (core/large_array.h: the
+        /// pages are first touched there, not in a serial memset). Builds
+        /// with HAIRVOX_POISON_UNINITIALIZED (the sanitizer builds) fill it
+        /// with NaN, so that a pixel left unwritten shows in the tests.
+        Uninitialized,
+    };
+
+    /// Adds a layer and returns its index. std::invalid_argument if the name
+    /// is taken or channels is not 1 or 3.
+    std::size_t addLayer(std::string name, int channels, bool fullPrecision = false,
+                         Init init = Init::Zero);
     std::optional<std::size_t> find(std::string_view name) const;
     /// The named layer; std::out_of_range naming it if absent.
     const FilmLayer& layer(std::string_view name) const;

@@ -43,6 +43,7 @@
 // the shader's average layers.
 #pragma once
 
+#include <hairvox/core/large_array.h>
 #include <hairvox/core/rgb.h>
 #include <hairvox/film/film.h>
 #include <hairvox/geometry/camera.h>
@@ -66,9 +67,10 @@ inline constexpr const char* kDepthLayer = "Z";
 /// camera's resolution): the fraction of the pixel they cover, their mean
 /// camera depth there and their mean outgoing radiance. Empty: no surfaces.
 struct SurfaceLayer {
-    std::vector<float> coverage; ///< [0, 1]; 0 where no surface
-    std::vector<float> depth;
-    std::vector<Rgb> radiance;
+    // (core/large_array.h: pipeline/surfaces.cpp fills them on its threads.)
+    LargeVector<float> coverage; ///< [0, 1]; 0 where no surface
+    LargeVector<float> depth;
+    LargeVector<Rgb> radiance;
 
     bool empty() const { return coverage.empty(); }
 };

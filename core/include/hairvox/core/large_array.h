@@ -1,0 +1,83 @@
+// hairvox core: storage for arrays of megabytes (the film, the projected
+// strand vertices, the global term's bricks and shadow lines).
+//
+// Two costs of such an array are its pages', not its bytes' (measured on
+// this project's 2-core VM, docs/DESIGN.md §7):
+//  - First touch. std::vector<T>::resize(n) value-initialises — for floats or
+//    plain structs a memset of the new range on the calling thread — and that
+//    memset is every page's fault and the kernel's zeroing of it, serially:
+//    the 1080p film (357 MiB) took 0.7 s on one core before a tile was
+//    drawn. A LargeVector's resize(n) default-initialises (nothing, for
+//    trivial types), so the pages are first touched by the threads that fill
+//    them. assign(n, v), resize(n, v) and construction from values still
+//    write. The elements added by resize(n) are indeterminate: use it only
+//    where every element is written before it is read (callers say where).
+//  - Address translation. The renderer reads these arrays scattered (a
+//    tile's strand vertices and film rows, a query's shadow lines); with
+//    4 KiB pages a tile of 32 rows × 40 layers alone spans over a thousand
+//    pages, and under a hypervisor every TLB miss is a two-level walk.
+//    Blocks of kHugePageBytes or more are therefore aligned to 2 MiB and
+//    advised to the kernel as transparent huge pages (madvise MADV_HUGEPAGE:
+//    used where /sys/kernel/mm/transparent_hugepage/enabled says "madvise"
+//    or "always", ignored where it says "never"). The default scene: 2.6 →
+//    2.0 s. Rounding the block up to 2 MiB costs at most 2 MiB per array.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <new>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+namespace hairvox {
+
+/// Blocks of at least this many bytes are backed by transparent huge pages.
+inline constexpr std::size_t kHugePageBytes = std::size_t(2) << 20;
+
+/// `bytes` of storage aligned to `alignment` (a power of two), on huge pages
+/// when bytes ≥ kHugePageBytes; std::bad_alloc when there is none. Release
+/// it with deallocateLarge() and the same size and alignment.
+void* allocateLarge(std::size_t bytes, std::size_t alignment);
+void deallocateLarge(void* p, std::size_t bytes, std::size_t alignment) noexcept;
+
+/// The allocator of LargeVector: allocateLarge(), and construct(p) without
+/// arguments default-initialises (the idiom of Boost.Container's
+/// default_init_t).
+template <typename T>
+class LargeArrayAllocator {
+public:
+    using value_type = T;
+
+    LargeArrayAllocator() noexcept = default;
+    template <typename U>
+    LargeArrayAllocator(const LargeArrayAllocator<U>&) noexcept {} // NOLINT: rebinding
+
+    T* allocate(std::size_t n) {
+        if (n > std::size_t(-1) / sizeof(T))
+            throw std::bad_array_new_length();
+        return static_cast<T*>(allocateLarge(n * sizeof(T), alignof(T)));
+    }
+    void deallocate(T* p, std::size_t n) noexcept { deallocateLarge(p, n * sizeof(T), alignof(T)); }
+
+    template <typename U>
+    void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
+        ::new (static_cast<void*>(p)) U;
+    }
+    template <typename U, typename... Args>
+    void construct(U* p, Args&&... args) {
+        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
+};
+
+template <typename T, typename U>
+bool operator==(const LargeArrayAllocator<T>&, const LargeArrayAllocator<U>&) noexcept {
+    return true;
+}
+
+/// A std::vector on huge pages whose resize(n) leaves new elements
+/// default-initialised.
+template <typename T>
+using LargeVector = std::vector<T, LargeArrayAllocator<T>>;
+
+} // namespace hairvox
