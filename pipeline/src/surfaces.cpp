@@ -1,7 +1,7 @@
 #include "surfaces.h"
 
-#include <hairvox/core/large_array.h>
 #include <hairvox/core/interrupt.h>
+#include <hairvox/core/large_array.h>
 #include <hairvox/core/math.h>
 
 #include <tbb/blocked_range.h>

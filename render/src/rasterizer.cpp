@@ -1,8 +1,8 @@
 #include "ribbon.h"
 
-#include <hairvox/core/large_array.h>
 #include <hairvox/core/error.h>
 #include <hairvox/core/interrupt.h>
+#include <hairvox/core/large_array.h>
 #include <hairvox/core/math.h>
 #include <hairvox/core/parallel.h>
 #include <hairvox/core/progress.h>

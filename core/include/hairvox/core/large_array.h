@@ -14,13 +14,14 @@
 //    where every element is written before it is read (callers say where).
 //  - Address translation. The renderer reads these arrays scattered (a
 //    tile's strand vertices and film rows, a query's shadow lines); with
-//    4 KiB pages a tile of 32 rows × 40 layers alone spans over a thousand
-//    pages, and under a hypervisor every TLB miss is a two-level walk.
-//    Blocks of kHugePageBytes or more are therefore aligned to 2 MiB and
-//    advised to the kernel as transparent huge pages (madvise MADV_HUGEPAGE:
-//    used where /sys/kernel/mm/transparent_hugepage/enabled says "madvise"
-//    or "always", ignored where it says "never"). The default scene: 2.6 →
-//    2.0 s. Rounding the block up to 2 MiB costs at most 2 MiB per array.
+//    4 KiB pages the 32 rows of one tile in the 19 layers of a 1080p film
+//    alone are some 600 pages, and under a hypervisor every TLB miss is a
+//    two-level walk. Blocks of kHugePageBytes or more are therefore aligned
+//    to 2 MiB and advised to the kernel as transparent huge pages (madvise
+//    MADV_HUGEPAGE: used where /sys/kernel/mm/transparent_hugepage/enabled
+//    says "madvise" or "always", ignored where it says "never"). Both
+//    together: the default scene 2.67 → 2.04 s, the head 5.50 → 4.51 s.
+//    Rounding a block up to 2 MiB costs at most 2 MiB per array.
 #pragma once
 
 #include <cstddef>
