@@ -17,7 +17,8 @@ ComparedImage ComparedImage::fromFilm(const Film& film, const std::vector<std::s
         for (std::size_t p = 0; p < film.pixelCount(); ++p)
             image.value[p] += layer.rgb(p);
     }
-    image.mask.assign(film.layer(maskLayer).data.begin(), film.layer(maskLayer).data.end());
+    const auto& mask = film.layer(maskLayer).data;
+    image.mask.assign(mask.begin(), mask.end());
     if (!halfLayer.empty()) {
         const FilmLayer& h = film.layer(halfLayer);
         image.halfA.resize(film.pixelCount());

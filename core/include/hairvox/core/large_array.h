@@ -19,9 +19,9 @@
 //    two-level walk. Blocks of kHugePageBytes or more are therefore aligned
 //    to 2 MiB and advised to the kernel as transparent huge pages (madvise
 //    MADV_HUGEPAGE: used where /sys/kernel/mm/transparent_hugepage/enabled
-//    says "madvise" or "always", ignored where it says "never"). Both
-//    together: the default scene 2.67 → 2.04 s, the head 5.50 → 4.51 s.
-//    Rounding a block up to 2 MiB costs at most 2 MiB per array.
+//    says "madvise" or "always", ignored where it says "never"). What both
+//    save, per scene, is in docs/DESIGN.md §7 ("Pages"). Rounding a block
+//    up to 2 MiB costs at most 2 MiB per array.
 #pragma once
 
 #include <cstddef>
