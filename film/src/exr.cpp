@@ -1,28 +1,31 @@
 #include <hairvox/core/atomic_file.h>
 #include <hairvox/core/error.h>
 #include <hairvox/core/interrupt.h>
-#include <hairvox/core/large_array.h>
 #include <hairvox/core/parallel.h>
 #include <hairvox/film/image_file.h>
 
+#include <hairvox/film/exr_codec.h>
 #include "half_convert.h"
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_pipeline.h>
 
 #include <ImfChannelList.h>
-#include <ImfCompressionAttribute.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
-#include <ImfOutputFile.h>
-#include <ImfStandardAttributes.h>
 #include <ImfStringAttribute.h>
-#include <ImfThreading.h>
+#include <openexr.h>
+#include <zlib.h>
+
 #include <algorithm>
-#include <cmath>
+#include <bit>
 #include <cstring>
 #include <exception>
-#include <memory>
+#include <new>
+#include <span>
+#include <string>
+#include <vector>
 
 namespace hairvox {
 
@@ -30,13 +33,8 @@ namespace {
 
 /// Largest finite half: a channel holding anything larger is stored as float.
 constexpr float kHalfMax = 65504.0f;
-/// Rows converted and written at a time, so that the half copies cost a band,
-/// not an image (and Ctrl-C is seen between bands); enough line blocks for
-/// OpenEXR's pool to compress in parallel. 64 rather than 256: a 43-channel
-/// 1080p band is then 21 MB, not 84, and fresh pages are what writing costs
-/// most on a VM (docs/DESIGN.md §7, "Pages": the write stage of a 1080p
-/// render of 10k segments 0.61–0.68 → 0.51–0.55 s, the same bytes).
-constexpr int kBandRows = 64;
+/// Longest name of a channel or attribute without the file's long-names flag.
+constexpr std::size_t kShortNameLength = 31;
 
 /// One EXR channel: where its floats are in the film and how it is stored.
 struct ExrChannel {
@@ -44,74 +42,163 @@ struct ExrChannel {
     const float* first; ///< pixel (0, 0)
     std::size_t stride; ///< floats between pixels (1 or 3)
     bool half;          ///< stored as half (else float)
+    std::size_t offset; ///< bytes from a packed scanline's start to this channel's values
 };
 
+/// The film's channels as an EXR scanline holds them: sorted by name (as
+/// OpenEXR's channel list is, by strcmp), each a row of little-endian halves
+/// or floats.
 class ExrLayout {
 public:
     explicit ExrLayout(const Film& film)
-        : width_(std::size_t(film.width()))
-        , pixels_(film.pixelCount()) {
+        : width_(std::size_t(film.width())) {
         static constexpr const char* rgb[3] = {"R", "G", "B"};
         for (const FilmLayer& l : film.layers()) {
             if (l.channels == 1) {
-                channels_.push_back({l.name, l.data.data(), 1, !l.fullPrecision});
+                channels_.push_back({l.name, l.data.data(), 1, !l.fullPrecision, 0});
                 continue;
             }
             for (int c = 0; c < 3; ++c)
                 channels_.push_back({l.name.empty() ? rgb[c] : l.name + "." + rgb[c],
-                                     l.data.data() + c, 3, !l.fullPrecision});
+                                     l.data.data() + c, 3, !l.fullPrecision, 0});
         }
+        std::sort(channels_.begin(), channels_.end(), [](const ExrChannel& a, const ExrChannel& b) {
+            return std::strcmp(a.name.c_str(), b.name.c_str()) < 0;
+        });
         // Half unless the layer asks for float or a value does not fit.
         tbb::parallel_for(std::size_t(0), channels_.size(), [&](std::size_t i) {
             ExrChannel& c = channels_[i];
-            c.half = c.half && detail::maxAbs(c.first, c.stride, pixels_) <= kHalfMax;
+            c.half = c.half && detail::maxAbs(c.first, c.stride, film.pixelCount()) <= kHalfMax;
         });
-    }
-
-    void declare(Imf::Header& header) const {
-        for (const ExrChannel& c : channels_)
-            header.channels().insert(c.name, Imf::Channel(c.half ? Imf::HALF : Imf::FLOAT));
-    }
-
-    /// Converts rows [y0, y0 + rows) into the band buffers and points `file` at them.
-    void setBand(Imf::OutputFile& file, int y0, int rows) {
-        const std::size_t capacity = width_ * std::size_t(kBandRows);
-        if (band_.empty()) // written before read: left unwritten by resize
-            band_.resize(channels_.size() * capacity);
-        const std::size_t count = width_ * std::size_t(rows);
-        // Channels × blocks of rows, converted on the calling threads while
-        // OpenEXR's pool waits for the band.
-        constexpr std::size_t kRowsPerTask = 64;
-        const std::size_t blocks = (std::size_t(rows) + kRowsPerTask - 1) / kRowsPerTask;
-        tbb::parallel_for(std::size_t(0), channels_.size() * blocks, [&](std::size_t task) {
-            const ExrChannel& c = channels_[task / blocks];
-            const std::size_t begin = (task % blocks) * kRowsPerTask * width_;
-            const std::size_t n = std::min(count, begin + kRowsPerTask * width_) - begin;
-            const float* src = c.first + (std::size_t(y0) * width_ + begin) * c.stride;
-            std::uint32_t* dst = band_.data() + (task / blocks) * capacity;
-            if (c.half)
-                detail::toHalf(src, c.stride, n, reinterpret_cast<std::uint16_t*>(dst) + begin);
-            else
-                for (std::size_t p = 0; p < n; ++p)
-                    std::memcpy(dst + begin + p, src + p * c.stride, sizeof(float));
-        });
-        Imf::FrameBuffer frameBuffer;
-        for (std::size_t i = 0; i < channels_.size(); ++i) {
-            const ExrChannel& c = channels_[i];
-            char* band = reinterpret_cast<char*>(band_.data() + i * capacity);
-            // The band's first value is pixel (0, y0).
-            frameBuffer.insert(c.name,
-                               Imf::Slice::Make(c.half ? Imf::HALF : Imf::FLOAT, band,
-                                                Imath::V2i(0, y0), std::int64_t(width_), rows));
+        for (ExrChannel& c : channels_) {
+            c.offset = lineBytes_;
+            lineBytes_ += width_ * (c.half ? sizeof(std::uint16_t) : sizeof(float));
         }
-        file.setFrameBuffer(frameBuffer);
+    }
+
+    const std::vector<ExrChannel>& channels() const { return channels_; }
+    std::size_t lineBytes() const { return lineBytes_; }
+
+    /// Scanline y as the file stores it, before compression.
+    void pack(int y, std::uint8_t* out) const {
+        static_assert(std::endian::native == std::endian::little, "EXR files are little-endian");
+        for (const ExrChannel& c : channels_) {
+            const float* src = c.first + std::size_t(y) * width_ * c.stride;
+            std::uint8_t* dst = out + c.offset;
+            if (c.half)
+                detail::toHalf(src, c.stride, width_, reinterpret_cast<std::uint16_t*>(dst));
+            else
+                for (std::size_t x = 0; x < width_; ++x)
+                    std::memcpy(dst + x * sizeof(float), src + x * c.stride, sizeof(float));
+        }
     }
 
 private:
-    std::size_t width_, pixels_;
+    std::size_t width_, lineBytes_ = 0;
     std::vector<ExrChannel> channels_;
-    /// One band: per channel kBandRows rows of halves or floats (4 bytes reserved per value).
-    LargeVector<std::uint32_t> band_;
+};
+
+/// Scanlines per chunk: OpenEXR's, per compression.
+int linesPerChunk(ExrCompression c) {
+    return c == ExrCompression::Zip ? 16 : 1;
+}
+
+/// One chunk's bytes, packed and compressed as the file stores them; owned
+/// by one chunk of the pipeline at a time.
+class ChunkEncoder {
+public:
+    /// Encodes scanlines [y, y + rows); the result is valid until the next call.
+    std::span<const std::uint8_t> encode(const ExrLayout& layout, int y, int rows,
+                                         ExrCompression compression, int zipLevel) {
+        const std::size_t bytes = layout.lineBytes() * std::size_t(rows);
+        packed_.resize(bytes);
+        for (int r = 0; r < rows; ++r)
+            layout.pack(y + r, packed_.data() + std::size_t(r) * layout.lineBytes());
+        std::size_t size = bytes;
+        switch (compression) {
+        case ExrCompression::None: return {packed_.data(), bytes};
+        case ExrCompression::Rle:
+            predicted_.resize(bytes);
+            detail::reorderAndPredict(packed_.data(), bytes, predicted_.data());
+            scratch_.resize(detail::rleScratchWords(bytes));
+            code_.resize(detail::rleCapacity(bytes));
+            size = detail::rleCompress(predicted_.data(), bytes, scratch_.data(), code_.data());
+            break;
+        case ExrCompression::Zip:
+        case ExrCompression::Zips: {
+            predicted_.resize(bytes);
+            detail::reorderAndPredict(packed_.data(), bytes, predicted_.data());
+            uLongf capacity = compressBound(uLong(bytes));
+            code_.resize(capacity);
+            // With compressBound's room and a valid level, zlib fails only
+            // for memory.
+            if (compress2(code_.data(), &capacity, predicted_.data(), uLong(bytes), zipLevel) !=
+                Z_OK)
+                throw std::bad_alloc();
+            size = capacity;
+            break;
+        }
+        }
+        // Not shorter than the bytes: stored raw (what a reader expects of
+        // a chunk whose size is the uncompressed size).
+        if (size >= bytes)
+            return {packed_.data(), bytes};
+        return {code_.data(), size};
+    }
+
+private:
+    std::vector<std::uint8_t> packed_, predicted_, code_;
+    std::vector<std::uint64_t> scratch_;
+};
+
+exr_compression_t coreCompression(ExrCompression c) {
+    switch (c) {
+    case ExrCompression::Zips: return EXR_COMPRESSION_ZIPS;
+    case ExrCompression::Zip: return EXR_COMPRESSION_ZIP;
+    case ExrCompression::Rle: return EXR_COMPRESSION_RLE;
+    case ExrCompression::None: return EXR_COMPRESSION_NONE;
+    }
+    throw std::logic_error("coreCompression");
+}
+
+/// An OpenEXR Core write context whose errors are thrown as InputError
+/// naming the file, and which is always finished.
+class ExrWriter {
+public:
+    ExrWriter(const std::filesystem::path& path, const std::filesystem::path& tmp)
+        : path_(path) {
+        exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+        init.user_data = &message_;
+        init.error_handler_fn = [](exr_const_context_t ctx, exr_result_t, const char* msg) {
+            void* user = nullptr;
+            if (exr_get_user_data(ctx, &user) == EXR_ERR_SUCCESS && user && msg)
+                *static_cast<std::string*>(user) = msg;
+        };
+        check(exr_start_write(&ctx_, tmp.c_str(), EXR_WRITE_FILE_DIRECTLY, &init));
+    }
+    ExrWriter(const ExrWriter&) = delete;
+    ExrWriter& operator=(const ExrWriter&) = delete;
+    ~ExrWriter() {
+        if (ctx_)
+            exr_finish(&ctx_);
+    }
+
+    exr_context_t get() const { return ctx_; }
+
+    void check(exr_result_t result) const {
+        if (result != EXR_ERR_SUCCESS)
+            throw InputError(strCat(path_.string(), ": cannot write OpenEXR file: ",
+                                    message_.empty() ? exr_get_default_error_message(result)
+                                                     : message_));
+    }
+
+    /// Writes the chunk offsets and closes the file.
+    void finish() { check(exr_finish(&ctx_)); }
+
+private:
+    std::filesystem::path path_;
+    std::string message_;
+    exr_context_t ctx_ = nullptr;
 };
 
 } // namespace
@@ -122,47 +209,81 @@ void writeExr(const std::filesystem::path& path, const Film& film, const ExrHead
     if (info.zipLevel < 1 || info.zipLevel > 9)
         throw InputError(strCat(path.string(), ": EXR zip level ", info.zipLevel,
                                 " should be in the range [1, 9]"));
-    Imf::Header header(film.width(), film.height());
-    switch (info.compression) { // the trade-offs: ExrCompression
-    case ExrCompression::Zips: header.compression() = Imf::ZIPS_COMPRESSION; break;
-    case ExrCompression::Zip: header.compression() = Imf::ZIP_COMPRESSION; break;
-    case ExrCompression::Rle: header.compression() = Imf::RLE_COMPRESSION; break;
-    case ExrCompression::None: header.compression() = Imf::NO_COMPRESSION; break;
-    }
-    header.zipCompressionLevel() = info.zipLevel;
-    if (info.worldToCamera) {
-        const Matrix44& m = *info.worldToCamera;
-        Imf::addWorldToCamera(header,
-                              Imath::M44f(m[0][0], m[0][1], m[0][2], m[0][3], m[1][0], m[1][1],
-                                          m[1][2], m[1][3], m[2][0], m[2][1], m[2][2], m[2][3],
-                                          m[3][0], m[3][1], m[3][2], m[3][3]));
-    }
-    header.insert("software", Imf::StringAttribute("hairvox"));
-    for (const auto& [key, value] : info.attributes)
-        header.insert(key, Imf::StringAttribute(value));
+    const ExrLayout layout(film);
+    const int lines = linesPerChunk(info.compression);
+    const auto chunks = std::size_t((film.height() + lines - 1) / lines);
 
-    ExrLayout layout(film);
-    layout.declare(header);
-
-    // OpenEXR compresses line blocks on its own global thread pool, which is
-    // empty unless sized: match it to the thread limit in force.
-    const int threads = activeThreadCount();
-    if (Imf::globalThreadCount() != threads)
-        Imf::setGlobalThreadCount(threads);
     writeFileAtomically(path, [&](const std::filesystem::path& tmp) {
-        try {
-            Imf::OutputFile file(tmp.c_str(), header, threads);
-            for (int y = 0; y < film.height(); y += kBandRows) {
-                throwIfInterrupted(); // a large image with many AOVs takes seconds to compress
-                const int rows = std::min(kBandRows, film.height() - y);
-                layout.setBand(file, y, rows);
-                file.writePixels(rows);
-            }
-        } catch (const Interrupted&) {
-            throw;
-        } catch (const std::exception& e) {
-            throw InputError(strCat(path.string(), ": cannot write OpenEXR file: ", e.what()));
+        ExrWriter file(path, tmp);
+        exr_context_t ctx = file.get();
+        int part = 0;
+        file.check(exr_add_part(ctx, nullptr, EXR_STORAGE_SCANLINE, &part));
+        file.check(exr_initialize_required_attr_simple(ctx, part, film.width(), film.height(),
+                                                       coreCompression(info.compression)));
+        bool longNames = false;
+        const auto name = [&](const std::string& n) {
+            longNames = longNames || n.size() > kShortNameLength;
+            return n.c_str();
+        };
+        for (const auto& [key, value] : info.attributes)
+            name(key);
+        for (const ExrChannel& c : layout.channels())
+            name(c.name);
+        if (longNames) // only then: readers older than OpenEXR 2 take 31 characters
+            file.check(exr_set_longname_support(ctx, 1));
+        for (const ExrChannel& c : layout.channels())
+            file.check(exr_add_channel(ctx, part, c.name.c_str(),
+                                       c.half ? EXR_PIXEL_HALF : EXR_PIXEL_FLOAT,
+                                       EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1));
+        if (info.worldToCamera) {
+            exr_attr_m44f_t m;
+            for (int r = 0; r < 4; ++r)
+                for (int c = 0; c < 4; ++c)
+                    m.m[4 * r + c] = (*info.worldToCamera)[std::size_t(r)][std::size_t(c)];
+            file.check(exr_attr_set_m44f(ctx, part, "worldToCamera", &m));
         }
+        file.check(exr_attr_set_string(ctx, part, "software", "hairvox"));
+        for (const auto& [key, value] : info.attributes)
+            file.check(exr_attr_set_string(ctx, part, key.c_str(), value.c_str()));
+        file.check(exr_write_header(ctx));
+
+        // Chunks packed and compressed in parallel, written in order (the
+        // bytes do not depend on the thread count). A chunk's encoder is
+        // slot chunk % tokens: at most `tokens` chunks are in flight and
+        // the last stage finishes them in order, so chunk c's slot is free
+        // when chunk c + tokens starts.
+        const std::size_t tokens = 2 * std::size_t(activeThreadCount());
+        std::vector<ChunkEncoder> encoders(tokens);
+        std::vector<std::span<const std::uint8_t>> encoded(tokens);
+        std::size_t next = 0;
+        tbb::parallel_pipeline(
+            tokens,
+            tbb::make_filter<void, std::size_t>(
+                tbb::filter_mode::serial_in_order,
+                [&](tbb::flow_control& control) -> std::size_t {
+                    if (next == chunks) {
+                        control.stop();
+                        return 0;
+                    }
+                    throwIfInterrupted(); // a large image with many AOVs takes a while
+                    return next++;
+                }) &
+                tbb::make_filter<std::size_t, std::size_t>(
+                    tbb::filter_mode::parallel,
+                    [&](std::size_t chunk) {
+                        const int y = int(chunk) * lines;
+                        encoded[chunk % tokens] = encoders[chunk % tokens].encode(
+                            layout, y, std::min(lines, film.height() - y), info.compression,
+                            info.zipLevel);
+                        return chunk;
+                    }) &
+                tbb::make_filter<std::size_t, void>(
+                    tbb::filter_mode::serial_in_order, [&](std::size_t chunk) {
+                        const std::span<const std::uint8_t> bytes = encoded[chunk % tokens];
+                        file.check(exr_write_scanline_chunk(ctx, part, int(chunk) * lines,
+                                                            bytes.data(), bytes.size()));
+                    }));
+        file.finish();
     });
 }
 

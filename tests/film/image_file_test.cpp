@@ -158,6 +158,24 @@ TEST(ExrFile, EveryCompressionIsLosslessAndTradesSize) {
     EXPECT_LT(size[ExrCompression::Rle], size[ExrCompression::None]);
 }
 
+TEST(ExrFile, NamesLongerThan31CharactersRoundTrip) {
+    // A light's AOVs carry its name: OpenEXR needs the file's long-names
+    // flag past 31 characters.
+    Film film(5, 4);
+    const std::string name = "a_rim_light_named_at_some_length.T_s";
+    FilmLayer& layer = film.layer(film.addLayer(name, 3));
+    for (std::size_t i = 0; i < layer.data.size(); ++i)
+        layer.data[i] = 0.25f * float(i % 7);
+    test::TempDir dir;
+    ExrHeader header;
+    header.attributes = {{"hairvox:an_attribute_named_past_31_chars", "x"}};
+    writeExr(dir / "long.exr", film, header);
+    const ExrImage exr = readExr(dir / "long.exr");
+    EXPECT_EQ(exr.attributes.at("hairvox:an_attribute_named_past_31_chars"), "x");
+    for (std::size_t p = 0; p < film.pixelCount(); ++p)
+        ASSERT_EQ(exr.channels.at(name + ".G")[p], layer.rgb(p)[1]); // quarters: exact in half
+}
+
 TEST(ExrFile, KeepsValuesBeyondHalfRange) {
     Film film(4, 2);
     film.addLayer(std::string(Film::kBeauty), 3);
