@@ -44,9 +44,9 @@ inline constexpr int kDefaultExrZipLevel = 1;
 
 /// How the EXR's pixels are compressed (OpenEXR's lossless schemes; the names
 /// are OpenEXR's). rle is the default: the 1080p head's 43 channels in
-/// 0.27–0.30 s for 27 MB, against 0.44–0.52 s for 21 MB with zips (zlib
-/// level 1) and 0.22–0.24 s for 182 MB with none (the EXR alone, 2 threads;
-/// docs/scene.md "Output" has the table).
+/// 0.11 s for 27.6 MB, against 0.34–0.36 s for 21.3 MB with zips (zlib
+/// level 1) and 0.24–0.29 s for 182 MB with none (the write stage, 2
+/// threads; docs/scene.md "Output" has the table).
 enum class ExrCompression { Zips, Zip, Rle, None };
 
 inline constexpr EnumNames<ExrCompression, 4> kExrCompressionNames{{{
@@ -62,10 +62,10 @@ inline const char* toString(ExrCompression c) {
 struct ExrHeader {
     std::optional<Matrix44> worldToCamera;
     std::map<std::string, std::string> attributes; ///< e.g. "hairvox:globalTermMode" → "grid"
-    /// zlib level of the ZIPS compression, [1, 9]. Measured on the default
-    /// scene at 1024² (43 channels, 2 cores, `hairvox render`'s write stage,
-    /// EXR alone): level 1 0.61–0.73 s for 18.7 MB, level 4 (OpenEXR's
-    /// default) 0.78–1.10 s for 18.0 MB.
+    /// zlib level of the zip and zips compressions, [1, 9]. Measured on the
+    /// 1080p head with zips (43 channels, 2 cores, `hairvox render`'s write
+    /// stage, three runs): level 1 0.34–0.36 s for 21.3 MB, level 4
+    /// (OpenEXR's default) 0.49–0.50 s for 20.2 MB.
     int zipLevel = kDefaultExrZipLevel;
     ExrCompression compression = ExrCompression::Rle;
 };
