@@ -1,7 +1,6 @@
 #include <hairvox/core/error.h>
 #include <hairvox/film/film.h>
 
-#include <limits>
 #include <stdexcept>
 
 namespace hairvox {
@@ -24,14 +23,10 @@ std::size_t Film::addLayer(std::string name, int channels, bool fullPrecision, I
     l.channels = channels;
     l.fullPrecision = fullPrecision;
     const std::size_t size = pixelCount() * std::size_t(channels);
-#ifdef HAIRVOX_POISON_UNINITIALIZED
-    l.data.assign(size, init == Init::Zero ? 0.0f : std::numeric_limits<float>::quiet_NaN());
-#else
     if (init == Init::Zero)
         l.data.assign(size, 0.0f);
     else
-        l.data.resize(size);
-#endif
+        l.data.resize(size); // NaN in the sanitizer builds (core/large_array.h)
     layers_.push_back(std::move(l));
     return layers_.size() - 1;
 }

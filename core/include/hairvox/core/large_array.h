@@ -1,7 +1,7 @@
 // hairvox core: storage for arrays of megabytes (the film, the projected
 // strand vertices, the global term's bricks and shadow lines).
 //
-// Two costs of such an array are its pages', not its bytes' (measured on
+// What such an array costs is its pages, not its bytes (measured on
 // this project's 2-core VM, docs/DESIGN.md §7):
 //  - First touch. std::vector<T>::resize(n) value-initialises — for floats or
 //    plain structs a memset of the new range on the calling thread — and that
@@ -22,6 +22,9 @@
 //    says "madvise" or "always", ignored where it says "never"). What both
 //    save, per scene, is in docs/DESIGN.md §7 ("Pages"). Rounding a block
 //    up to 2 MiB costs at most 2 MiB per array.
+// Builds that poison what is not written (HAIRVOX_POISON_UNINITIALIZED, the
+// sanitizer builds) fill every new block with 0xFF bytes — NaN as floats —
+// so that a read before the first write shows in the tests.
 #pragma once
 
 #include <cstddef>
