@@ -2,6 +2,9 @@
 
 #include <hairvox/core/error.h>
 
+#include <gtest/gtest.h>
+#include <hwy/targets.h>
+
 #include <array>
 #include <atomic>
 #include <cstdio>
@@ -57,6 +60,15 @@ CommandResult runShell(const std::string& command) {
     const int status = ::pclose(pipe);
     result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
     return result;
+}
+
+void forEachSimdTarget(const std::function<void()>& check) {
+    for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
+        hwy::SetSupportedTargetsForTest(target);
+        SCOPED_TRACE(hwy::TargetName(target));
+        check();
+    }
+    hwy::SetSupportedTargetsForTest(0); // back to the best target
 }
 
 } // namespace hairvox::test

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -59,5 +60,10 @@ struct CommandResult {
 CommandResult runHairvox(const std::string& args);
 /// Runs a shell command line; exit code 127 means "command not found".
 CommandResult runShell(const std::string& command);
+
+/// Calls `check` once per SIMD target this CPU runs (Highway's dynamic
+/// dispatch forced to each: AVX-512, AVX2, SSE4, the portable baseline),
+/// with the target's name in the failures' trace.
+void forEachSimdTarget(const std::function<void()>& check);
 
 } // namespace hairvox::test

@@ -1,7 +1,10 @@
 // The EXR chunk codec (film/exr_codec.h) against OpenEXR's own byte loops:
 // the same predicted bytes and the same run-length code, byte for byte, on
 // inputs made to hit every branch of the parse (runs of 1 to 300, literals
-// cut at 127, ends inside a run of two) and on every small size.
+// cut at 127, ends inside a run of two) and on every small size — with every
+// SIMD target this CPU runs (AVX-512, AVX2, SSE4, the portable baseline).
+#include "test_util.h"
+
 #include <hairvox/core/rng.h>
 #include <hairvox/film/exr_codec.h>
 
@@ -115,61 +118,67 @@ Bytes runs(std::size_t n, std::uint32_t maxRun, std::uint32_t values, Pcg32& rng
 }
 
 TEST(ExrCodec, EverySmallSizeGivesOpenExrsBytes) {
-    Pcg32 rng(3);
-    for (std::size_t n = 0; n <= 300; ++n) {
-        expectOpenExrBytes(runs(n, 5, 3, rng), "short runs");
-        expectOpenExrRle(runs(n, 5, 3, rng), "short runs");
-        expectOpenExrBytes(Bytes(n, 7), "one value");
-        expectOpenExrRle(Bytes(n, 7), "one value");
-        Bytes noise(n);
-        for (std::uint8_t& b : noise)
-            b = static_cast<std::uint8_t>(below(rng, 256));
-        expectOpenExrBytes(noise, "noise");
-    }
+    test::forEachSimdTarget([] {
+        Pcg32 rng(3);
+        for (std::size_t n = 0; n <= 300; ++n) {
+            expectOpenExrBytes(runs(n, 5, 3, rng), "short runs");
+            expectOpenExrRle(runs(n, 5, 3, rng), "short runs");
+            expectOpenExrBytes(Bytes(n, 7), "one value");
+            expectOpenExrRle(Bytes(n, 7), "one value");
+            Bytes noise(n);
+            for (std::uint8_t& b : noise)
+                b = static_cast<std::uint8_t>(below(rng, 256));
+            expectOpenExrBytes(noise, "noise");
+        }
+    });
 }
 
 TEST(ExrCodec, EveryRunAndLiteralLengthGivesOpenExrsBytes) {
-    Pcg32 rng(5);
-    for (std::uint32_t k = 1; k <= 260; ++k) {
-        // Runs of exactly k equal bytes between literals of k bytes: the
-        // caps at 128 (runs) and 127 (literals) and the runs of two inside
-        // literals.
-        Bytes code;
-        for (int block = 0; block < 6; ++block)
-            for (std::uint32_t i = 0; i < k; ++i)
-                code.push_back(block % 2 == 0 ? std::uint8_t(block) : std::uint8_t(below(rng, 256)));
-        expectOpenExrRle(code, "runs and literals of " + std::to_string(k));
-        // Packed halves constant over k pixels: runs of 128s after the predictor.
-        Bytes packed;
-        for (const std::uint8_t v : code) {
-            packed.push_back(v);
-            packed.push_back(std::uint8_t(v ^ 0x55));
+    test::forEachSimdTarget([] {
+        Pcg32 rng(5);
+        for (std::uint32_t k = 1; k <= 260; ++k) {
+            // Runs of exactly k equal bytes between literals of k bytes: the
+            // caps at 128 (runs) and 127 (literals) and the runs of two inside
+            // literals.
+            Bytes code;
+            for (int block = 0; block < 6; ++block)
+                for (std::uint32_t i = 0; i < k; ++i)
+                    code.push_back(block % 2 == 0 ? std::uint8_t(block) : std::uint8_t(below(rng, 256)));
+            expectOpenExrRle(code, "runs and literals of " + std::to_string(k));
+            // Packed halves constant over k pixels: runs of 128s after the predictor.
+            Bytes packed;
+            for (const std::uint8_t v : code) {
+                packed.push_back(v);
+                packed.push_back(std::uint8_t(v ^ 0x55));
+            }
+            expectOpenExrBytes(packed, "halves constant over " + std::to_string(k));
         }
-        expectOpenExrBytes(packed, "halves constant over " + std::to_string(k));
-    }
-    for (const std::uint32_t maxRun : {2u, 3u, 4u, 130u, 300u})
-        for (const std::uint32_t values : {2u, 4u, 256u}) {
-            const std::string what =
-                "runs up to " + std::to_string(maxRun) + " of " + std::to_string(values) + " values";
-            expectOpenExrRle(runs(100'003, maxRun, values, rng), what);
-            expectOpenExrBytes(runs(100'003, maxRun, values, rng), what);
-        }
+        for (const std::uint32_t maxRun : {2u, 3u, 4u, 130u, 300u})
+            for (const std::uint32_t values : {2u, 4u, 256u}) {
+                const std::string what =
+                    "runs up to " + std::to_string(maxRun) + " of " + std::to_string(values) + " values";
+                expectOpenExrRle(runs(100'003, maxRun, values, rng), what);
+                expectOpenExrBytes(runs(100'003, maxRun, values, rng), what);
+            }
+    });
 }
 
 TEST(ExrCodec, ARenderLikeScanlineGivesOpenExrsBytes) {
-    // Halves of a smooth ramp over flat background (what renders are), with
-    // noise in the low bits: a scanline of 1920 pixels × 43 channels.
-    Pcg32 rng(11);
-    Bytes packed;
-    for (int channel = 0; channel < 43; ++channel)
-        for (int x = 0; x < 1920; ++x) {
-            const bool hair = x > 600 && x < 1400;
-            const auto half = static_cast<std::uint16_t>(
-                hair ? 0x3800 + (x % 97) * 3 + int(below(rng, 4)) : channel % 3 == 0 ? 0 : 0x2e66);
-            packed.push_back(std::uint8_t(half & 0xff));
-            packed.push_back(std::uint8_t(half >> 8));
-        }
-    expectOpenExrBytes(packed, "render-like scanline");
+    test::forEachSimdTarget([] {
+        // Halves of a smooth ramp over flat background (what renders are), with
+        // noise in the low bits: a scanline of 1920 pixels × 43 channels.
+        Pcg32 rng(11);
+        Bytes packed;
+        for (int channel = 0; channel < 43; ++channel)
+            for (int x = 0; x < 1920; ++x) {
+                const bool hair = x > 600 && x < 1400;
+                const auto half = static_cast<std::uint16_t>(
+                    hair ? 0x3800 + (x % 97) * 3 + int(below(rng, 4)) : channel % 3 == 0 ? 0 : 0x2e66);
+                packed.push_back(std::uint8_t(half & 0xff));
+                packed.push_back(std::uint8_t(half >> 8));
+            }
+        expectOpenExrBytes(packed, "render-like scanline");
+    });
 }
 
 } // namespace

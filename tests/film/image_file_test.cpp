@@ -191,43 +191,45 @@ TEST(ExrFile, HalvesRoundAsImathDoesOnEveryCpu) {
     // with Imath elsewhere: both must give Imath's bits (round to nearest,
     // ties to even), over the whole half range — denormals, ties, the top —
     // in scalar and RGB layers (3 floats apart) and in the vector tails.
-    constexpr int width = 259, height = 7;
-    Film film(width, height);
-    const std::size_t rgbLayer = film.addLayer("direct_R", 3);
-    const std::size_t scalarLayer = film.addLayer("key.V", 1);
-    FilmLayer& rgb = film.layer(rgbLayer);
-    FilmLayer& scalar = film.layer(scalarLayer);
-    Pcg32 rng(17);
-    std::vector<float> special{0.0f, -0.0f, 65504.0f, -65504.0f, 6.1035156e-5f, 5.9604645e-8f,
-                               2.9802322e-8f, 2.9802326e-8f, 8.940697e-8f, 1.0f + 1.0f / 2048.0f,
-                               1.0f + 3.0f / 2048.0f, 2049.0f, 2051.0f, 1e-30f};
-    const auto value = [&](std::size_t i) {
-        if (i < special.size())
-            return special[i];
-        // Exponents from 2^-30 (below every half) to 2^15, either sign.
-        const float x = std::ldexp(1.0f + rng.uniformFloat(), int(rng.uniformFloat() * 46.0f) - 30);
-        return rng.uniformFloat() < 0.5f ? -x : x;
-    };
-    for (std::size_t i = 0; i < rgb.data.size(); ++i)
-        rgb.data[i] = value(i);
-    for (std::size_t i = 0; i < scalar.data.size(); ++i)
-        scalar.data[i] = value(i);
-    test::TempDir dir;
-    writeExr(dir / "halves.exr", film);
-    const ExrImage exr = readExr(dir / "halves.exr");
-    const char* names[3] = {"direct_R.R", "direct_R.G", "direct_R.B"};
-    for (std::size_t p = 0; p < film.pixelCount(); ++p) {
-        for (std::size_t c = 0; c < 3; ++c) {
-            const float x = rgb.data[3 * p + c];
-            ASSERT_EQ(std::bit_cast<std::uint32_t>(exr.channels.at(names[c])[p]),
+    test::forEachSimdTarget([] {
+        constexpr int width = 259, height = 7;
+        Film film(width, height);
+        const std::size_t rgbLayer = film.addLayer("direct_R", 3);
+        const std::size_t scalarLayer = film.addLayer("key.V", 1);
+        FilmLayer& rgb = film.layer(rgbLayer);
+        FilmLayer& scalar = film.layer(scalarLayer);
+        Pcg32 rng(17);
+        std::vector<float> special{0.0f, -0.0f, 65504.0f, -65504.0f, 6.1035156e-5f, 5.9604645e-8f,
+                                   2.9802322e-8f, 2.9802326e-8f, 8.940697e-8f, 1.0f + 1.0f / 2048.0f,
+                                   1.0f + 3.0f / 2048.0f, 2049.0f, 2051.0f, 1e-30f};
+        const auto value = [&](std::size_t i) {
+            if (i < special.size())
+                return special[i];
+            // Exponents from 2^-30 (below every half) to 2^15, either sign.
+            const float x = std::ldexp(1.0f + rng.uniformFloat(), int(rng.uniformFloat() * 46.0f) - 30);
+            return rng.uniformFloat() < 0.5f ? -x : x;
+        };
+        for (std::size_t i = 0; i < rgb.data.size(); ++i)
+            rgb.data[i] = value(i);
+        for (std::size_t i = 0; i < scalar.data.size(); ++i)
+            scalar.data[i] = value(i);
+        test::TempDir dir;
+        writeExr(dir / "halves.exr", film);
+        const ExrImage exr = readExr(dir / "halves.exr");
+        const char* names[3] = {"direct_R.R", "direct_R.G", "direct_R.B"};
+        for (std::size_t p = 0; p < film.pixelCount(); ++p) {
+            for (std::size_t c = 0; c < 3; ++c) {
+                const float x = rgb.data[3 * p + c];
+                ASSERT_EQ(std::bit_cast<std::uint32_t>(exr.channels.at(names[c])[p]),
+                          std::bit_cast<std::uint32_t>(float(Imath::half(x))))
+                    << "pixel " << p << " channel " << c << " value " << x;
+            }
+            const float x = scalar.data[p];
+            ASSERT_EQ(std::bit_cast<std::uint32_t>(exr.channels.at("key.V")[p]),
                       std::bit_cast<std::uint32_t>(float(Imath::half(x))))
-                << "pixel " << p << " channel " << c << " value " << x;
+                << "pixel " << p << " value " << x;
         }
-        const float x = scalar.data[p];
-        ASSERT_EQ(std::bit_cast<std::uint32_t>(exr.channels.at("key.V")[p]),
-                  std::bit_cast<std::uint32_t>(float(Imath::half(x))))
-            << "pixel " << p << " value " << x;
-    }
+    });
 }
 
 TEST(PngFile, IsTheTonemappedPreview) {
