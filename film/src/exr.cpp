@@ -2,9 +2,9 @@
 #include <hairvox/core/error.h>
 #include <hairvox/core/interrupt.h>
 #include <hairvox/core/parallel.h>
+#include <hairvox/film/exr_codec.h>
 #include <hairvox/film/image_file.h>
 
-#include <hairvox/film/exr_codec.h>
 #include "half_convert.h"
 
 #include <tbb/parallel_for.h>
@@ -114,20 +114,17 @@ public:
         packed_.resize(bytes);
         for (int r = 0; r < rows; ++r)
             layout.pack(y + r, packed_.data() + std::size_t(r) * layout.lineBytes());
-        std::size_t size = bytes;
-        switch (compression) {
-        case ExrCompression::None: return {packed_.data(), bytes};
-        case ExrCompression::Rle:
-            predicted_.resize(bytes);
-            detail::reorderAndPredict(packed_.data(), bytes, predicted_.data());
+        if (compression == ExrCompression::None)
+            return {packed_.data(), bytes};
+        // OpenEXR's predictor, then run lengths or zlib.
+        predicted_.resize(bytes);
+        detail::reorderAndPredict(packed_.data(), bytes, predicted_.data());
+        std::size_t size = 0;
+        if (compression == ExrCompression::Rle) {
             scratch_.resize(detail::rleScratchWords(bytes));
             code_.resize(detail::rleCapacity(bytes));
             size = detail::rleCompress(predicted_.data(), bytes, scratch_.data(), code_.data());
-            break;
-        case ExrCompression::Zip:
-        case ExrCompression::Zips: {
-            predicted_.resize(bytes);
-            detail::reorderAndPredict(packed_.data(), bytes, predicted_.data());
+        } else { // zip, zips: zlib at the scene's level
             uLongf capacity = compressBound(uLong(bytes));
             code_.resize(capacity);
             // With compressBound's room and a valid level, zlib fails only
@@ -136,8 +133,6 @@ public:
                 Z_OK)
                 throw std::bad_alloc();
             size = capacity;
-            break;
-        }
         }
         // Not shorter than the bytes: stored raw (what a reader expects of
         // a chunk whose size is the uncompressed size).

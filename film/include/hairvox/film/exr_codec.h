@@ -10,7 +10,7 @@
 //      else as literals of at most 127 bytes (−length, bytes...); ZIP: zlib.
 // A chunk whose code is not shorter than its bytes is stored raw. OpenEXR
 // does both steps a byte at a time, and its RLE was most of the 1080p
-// write (docs/DESIGN.md §7, "The write"); here the predictor runs across
+// write (docs/DESIGN.md §7, "Writing"); here the predictor runs across
 // SIMD lanes and RLE finds its runs from bit masks of equal neighbours, a
 // whole run or literal per step. tests/film/exr_codec_test.cpp checks the
 // bytes against OpenEXR's own code.
