@@ -45,6 +45,8 @@ Bytes openexrPredict(const Bytes& packed) {
 Bytes openexrRle(const Bytes& src) {
     constexpr int kMinRunLength = 3, kMaxRunLength = 127;
     Bytes out;
+    if (src.empty()) // (OpenEXR never calls it so: no pointer arithmetic on null)
+        return out;
     const auto* runs = reinterpret_cast<const std::int8_t*>(src.data());
     const std::int8_t* end = runs + src.size();
     const std::int8_t* rune = runs + 1;

@@ -1,5 +1,6 @@
-// hairvox film (internal; public for its tests): the byte transforms of OpenEXR's lossless chunk
-// compressions, written for speed and producing OpenEXR's bytes exactly.
+// hairvox film (internal; public for its tests): the byte transforms of
+// OpenEXR's lossless chunk compressions, written for speed and producing
+// OpenEXR's bytes exactly.
 //
 // OpenEXR 3.1 (OpenEXRCore/internal_rle.c, internal_zip.c) compresses a
 // chunk — its scanlines' channels packed one after another — in two steps:
