@@ -24,8 +24,8 @@ if(HAIRVOX_SANITIZE)
         -fno-sanitize-recover=all)
     add_compile_options(${HAIRVOX_SANITIZE_FLAGS})
     add_link_options(${HAIRVOX_SANITIZE_FLAGS})
-    # Storage left uninitialised for its producer to fill (Film::Init) is
-    # filled with NaN instead, so that a value left unwritten fails the tests.
+    # Every large array (core/large_array.h) starts as 0xFF bytes, NaN as
+    # floats, so that a value read before it is written fails the tests.
     add_compile_definitions(HAIRVOX_POISON_UNINITIALIZED=1)
 endif()
 

@@ -199,6 +199,13 @@ private:
     exr_context_t ctx_ = nullptr;
 };
 
+/// A chunk on its way to the file: its first scanline and its bytes (in its
+/// encoder's buffers).
+struct EncodedChunk {
+    int y = 0;
+    std::span<const std::uint8_t> bytes;
+};
+
 /// Hands a file's pages to the disk as they fill — writeback started every
 /// few megabytes, not waited for — so that the fsync before the rename
 /// (core/atomic_file.h) waits for the last of them, not the whole file: at
@@ -249,15 +256,12 @@ void writeExr(const std::filesystem::path& path, const Film& film, const ExrHead
         file.check(exr_add_part(ctx, nullptr, EXR_STORAGE_SCANLINE, &part));
         file.check(exr_initialize_required_attr_simple(ctx, part, film.width(), film.height(),
                                                        coreCompression(info.compression)));
-        bool longNames = false;
-        const auto name = [&](const std::string& n) {
-            longNames = longNames || n.size() > kShortNameLength;
-            return n.c_str();
-        };
-        for (const auto& [key, value] : info.attributes)
-            name(key);
-        for (const ExrChannel& c : layout.channels())
-            name(c.name);
+        const auto isLong = [](const std::string& n) { return n.size() > kShortNameLength; };
+        const bool longNames =
+            std::any_of(info.attributes.begin(), info.attributes.end(),
+                        [&](const auto& attribute) { return isLong(attribute.first); }) ||
+            std::any_of(layout.channels().begin(), layout.channels().end(),
+                        [&](const ExrChannel& c) { return isLong(c.name); });
         if (longNames) // only then: readers older than OpenEXR 2 take 31 characters
             file.check(exr_set_longname_support(ctx, 1));
         for (const ExrChannel& c : layout.channels())
@@ -284,7 +288,6 @@ void writeExr(const std::filesystem::path& path, const Film& film, const ExrHead
         EarlyWriteback writeback(tmp);
         const std::size_t tokens = 2 * std::size_t(activeThreadCount());
         std::vector<ChunkEncoder> encoders(tokens);
-        std::vector<std::span<const std::uint8_t>> encoded(tokens);
         std::size_t next = 0;
         tbb::parallel_pipeline(
             tokens,
@@ -298,21 +301,19 @@ void writeExr(const std::filesystem::path& path, const Film& film, const ExrHead
                     throwIfInterrupted(); // a large image with many AOVs takes a while
                     return next++;
                 }) &
-                tbb::make_filter<std::size_t, std::size_t>(
+                tbb::make_filter<std::size_t, EncodedChunk>(
                     tbb::filter_mode::parallel,
                     [&](std::size_t chunk) {
                         const int y = int(chunk) * lines;
-                        encoded[chunk % tokens] = encoders[chunk % tokens].encode(
-                            layout, y, std::min(lines, film.height() - y), info.compression,
-                            info.zipLevel);
-                        return chunk;
+                        return EncodedChunk{y, encoders[chunk % tokens].encode(
+                                                   layout, y, std::min(lines, film.height() - y),
+                                                   info.compression, info.zipLevel)};
                     }) &
-                tbb::make_filter<std::size_t, void>(
-                    tbb::filter_mode::serial_in_order, [&](std::size_t chunk) {
-                        const std::span<const std::uint8_t> bytes = encoded[chunk % tokens];
-                        file.check(exr_write_scanline_chunk(ctx, part, int(chunk) * lines,
-                                                            bytes.data(), bytes.size()));
-                        writeback.written(bytes.size());
+                tbb::make_filter<EncodedChunk, void>(
+                    tbb::filter_mode::serial_in_order, [&](const EncodedChunk& c) {
+                        file.check(exr_write_scanline_chunk(ctx, part, c.y, c.bytes.data(),
+                                                            c.bytes.size()));
+                        writeback.written(c.bytes.size());
                     }));
         file.finish();
     });
