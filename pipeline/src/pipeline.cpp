@@ -651,6 +651,8 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
         std::snprintf(line, sizeof(line), "  %-12s %7.3f s  %s\n", stage, seconds, detail.c_str());
         os << line;
     };
+    // A further line of the stage above: no time of its own.
+    const auto more = [&](const std::string& detail) { os << std::string(26, ' ') << detail << '\n'; };
     std::string written;
     for (const auto& p : r.written)
         written += (written.empty() ? "" : ", ") + p.string();
@@ -670,7 +672,7 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
         std::snprintf(line, sizeof(line), "%s paths stopped at the depth cap %u (throughput %.2g)",
                       thousands(pt.pathsAtDepthCap).c_str(), scene.pathTrace.maxDepth,
                       pt.energyAtDepthCap);
-        row("", 0.0, line);
+        more(line);
         row("write", r.times.write, written.empty() ? "nothing" : written);
         return;
     }
@@ -679,7 +681,7 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
         thousands(st.segments) + " segments" +
             (r.surfaceTriangles > 0 ? ", " + thousands(r.surfaceTriangles) + " triangles" : ""));
     for (const std::string& note : r.groomNotes)
-        row("", 0.0, note);
+        more(note);
     if (r.voxelSize > 0) {
         std::snprintf(line, sizeof(line), "%s active voxels of %.3g",
                       thousands(r.activeVoxels).c_str(), r.voxelSize);
@@ -707,6 +709,16 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
             thousands(blocked) + " behind surfaces, " + thousands(empty) +
             " with nothing in front" +
             (held > 0 ? strCat("; ", (held + 500'000) / 1'000'000, " MB held") : std::string()));
+    // What each light's preparation (the grid modes' cache) took: the lights
+    // are prepared concurrently, so these overlap within the stage's time.
+    std::string prepared;
+    for (const LightReport& l : r.lights)
+        if (!l.skipped) {
+            std::snprintf(line, sizeof(line), "%s %.3f s", l.name.c_str(), l.prepareSeconds);
+            prepared += (prepared.empty() ? "" : ", ") + std::string(line);
+        }
+    if (!prepared.empty() && scene.globalTermMode != GlobalTermMode::Exact)
+        more("prepared per light, concurrently: " + prepared);
     row("raster", r.times.raster,
         thousands(st.fragments) + " fragments; skipped: " + thousands(st.segmentsOutsideView) +
             " segments outside the view, " + thousands(st.segmentTilesBehindSurfaces) +

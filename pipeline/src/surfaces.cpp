@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <memory>
 
 namespace hairvox::detail {
 
@@ -76,14 +77,14 @@ SurfaceLayer surfaceLayer(const SurfaceScene& surfaces, const std::vector<Rgb>& 
     if (surfaces.empty()) {
         layer.coverage.assign(pixels, 0.0f);
         layer.depth.assign(pixels, 0.0f);
-        layer.radiance.assign(pixels, Rgb(0.0f));
+        layer.radiance = LargeBuffer<Rgb>(pixels, Rgb(0.0f));
         return layer;
     }
     // Every pixel is written by the parallel loops below (so that their
     // threads touch the pages first, core/large_array.h).
     layer.coverage.resize(pixels);
     layer.depth.resize(pixels);
-    layer.radiance.assign(pixels, Rgb(0.0f)); // (Rgb's constructor writes anyway)
+    layer.radiance = LargeBuffer<Rgb>(pixels); // zeroed row by row below
 
     // 1. Visibility at the pixel corners.
     const std::size_t cornerRow = std::size_t(width) + 1;
@@ -100,6 +101,8 @@ SurfaceLayer surfaceLayer(const SurfaceScene& surfaces, const std::vector<Rgb>& 
     std::vector<std::vector<ShadingSample>> rows(static_cast<std::size_t>(height));
     tbb::parallel_for(0, height, [&](int y) {
         std::vector<ShadingSample>& out = rows[std::size_t(y)];
+        std::uninitialized_fill_n(layer.radiance.begin() + std::size_t(y) * std::size_t(width),
+                                  width, Rgb(0.0f));
         for (int x = 0; x < width; ++x) {
             const std::size_t p = std::size_t(y) * std::size_t(width) + std::size_t(x);
             const CornerHit* c[4] = {&corners[std::size_t(y) * cornerRow + std::size_t(x)],

@@ -424,7 +424,7 @@ SurfaceLayer discSurface(const Camera& camera, float r, float depthValue, const 
     const std::size_t pixels = std::size_t(camera.width()) * std::size_t(camera.height());
     s.coverage.assign(pixels, 0.0f);
     s.depth.assign(pixels, 0.0f);
-    s.radiance.assign(pixels, Rgb(0.0f));
+    s.radiance = LargeBuffer<Rgb>(pixels, Rgb(0.0f));
     for (int y = 0; y < camera.height(); ++y)
         for (int x = 0; x < camera.width(); ++x) {
             const float dx = float(x) + 0.5f - 0.5f * float(camera.width());
@@ -486,7 +486,7 @@ TEST(RasterSurfaces, WrongSizeIsAnInputError) {
     SurfaceLayer bad;
     bad.coverage.assign(10, 1.0f);
     bad.depth.assign(10, 1.0f);
-    bad.radiance.assign(10, Rgb(1.0f));
+    bad.radiance = LargeBuffer<Rgb>(10, Rgb(1.0f));
     const test::ConstantShader shader;
     EXPECT_THROW(rasterize(Groom{}, camera, shader, testSettings(1e-3f), bad), InputError);
 }

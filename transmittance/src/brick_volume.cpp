@@ -88,7 +88,7 @@ BrickVolume::BrickVolume(double voxelSize)
     , slots_(64, -1) {}
 
 std::size_t BrickVolume::memoryBytes() const {
-    return valueCount_ * sizeof(Lanes) + present_.capacity() * sizeof(SlotBits) +
+    return values_.size() * sizeof(Lanes) + present_.capacity() * sizeof(SlotBits) +
            valueBase_.capacity() * sizeof(std::size_t) +
            cellMask_.capacity() * sizeof(cellMask_[0]) +
            (occupancy_.capacity() + superOccupancy_.capacity()) * sizeof(std::uint64_t) +
@@ -143,10 +143,6 @@ void BrickVolume::reserveBrick(const glm::ivec3& b, int lowFaces) {
             insert(b - glm::ivec3((mask >> 2) & 1, (mask >> 1) & 1, mask & 1));
 }
 
-void BrickVolume::LargeDelete::operator()(Lanes* p) const {
-    deallocateLarge(p, bytes, alignof(Lanes));
-}
-
 bool BrickVolume::occupied(const glm::ivec3& b) const {
     return boxBitSet(occupancy_, b, brickMin_, brickMax_);
 }
@@ -198,19 +194,16 @@ void BrickVolume::allocateValues() {
         }
     });
     valueBase_.resize(brickCount_);
-    valueCount_ = 0;
+    std::size_t valueCount = 0;
     for (std::size_t brick = 0; brick < brickCount_; ++brick) {
-        valueBase_[brick] = valueCount_;
-        valueCount_ += counts[brick];
+        valueBase_[brick] = valueCount;
+        valueCount += counts[brick];
     }
-    // Lanes is an aggregate (an implicit-lifetime type): raw storage filled
-    // with value-initialised Lanes, brick by brick on the threads.
-    const std::size_t bytes = std::max<std::size_t>(valueCount_, 1) * sizeof(Lanes);
-    values_ = std::unique_ptr<Lanes[], LargeDelete>(
-        static_cast<Lanes*>(allocateLarge(bytes, alignof(Lanes))), LargeDelete{bytes});
+    // Zeroed brick by brick on the threads (the apron slots no voxel sets stay zero).
+    values_ = LargeBuffer<Lanes>(valueCount);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, brickCount_, 64), [&](const auto& r) {
-        std::uninitialized_value_construct(values_.get() + valueBase_[r.begin()],
-                                           values_.get() + valueBase_[r.end() - 1] +
+        std::uninitialized_value_construct(values_.begin() + valueBase_[r.begin()],
+                                           values_.begin() + valueBase_[r.end() - 1] +
                                                counts[r.end() - 1]);
     });
 }

@@ -21,6 +21,7 @@
 // (4³ bricks) at a time.
 #pragma once
 
+#include <hairvox/core/large_array.h>
 #include <hairvox/core/rgb.h>
 #include <hairvox/core/vecmath.h>
 
@@ -29,7 +30,6 @@
 #include <array>
 #include <bit>
 #include <cstdint>
-#include <memory>
 #include <span>
 #include <vector>
 
@@ -199,18 +199,13 @@ private:
     std::vector<std::int64_t> slots_;  ///< open addressing: brick index per slot, −1 if free
     std::size_t brickCount_ = 0;
     std::vector<glm::ivec3> brickCoord_; ///< per brick
-    struct LargeDelete {
-        std::size_t bytes; ///< (no initialiser: GCC would not see the deleter as default-constructible)
-        void operator()(Lanes* p) const;
-    };
     std::vector<SlotBits> present_; ///< per brick
     std::vector<std::size_t> valueBase_; ///< per brick, its first value in values_
     /// Per brick, one bit per cell (x·64 + y·8 + z) set where a corner of the
     /// cell holds a value: a line's walk skips the other cells on one test.
     std::vector<std::array<std::uint64_t, 8>> cellMask_;
-    /// The packed values of every brick, once allocate() has run.
-    std::unique_ptr<Lanes[], LargeDelete> values_; ///< on huge pages (core/large_array.h)
-    std::size_t valueCount_ = 0;
+    /// The packed values of every brick, once allocateValues() has run.
+    LargeBuffer<Lanes> values_;
     glm::ivec3 brickMin_{0}, brickMax_{-1};
     /// One bit per brick position of [brickMin_, brickMax_] (x fastest), set
     /// where a brick exists; built by allocateSlots().

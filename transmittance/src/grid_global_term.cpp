@@ -226,13 +226,11 @@ public:
     GlobalTermStats evaluate(std::span<const GlobalTermQuery> queries,
                              std::span<GlobalTerm> out) const override {
         std::vector<unsigned char> empty(queries.size(), 0);
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, queries.size(), 64),
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, queries.size(), kBatch),
                           [&](const tbb::blocked_range<std::size_t>& range) {
-                              for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                                  bool touched = false;
-                                  out[i] = evaluateOne(queries[i], touched);
-                                  empty[i] = touched ? 0 : 1;
-                              }
+                              for (std::size_t b = range.begin(); b < range.end(); b += kBatch)
+                                  evaluateBatch(queries.subspan(b, std::min(kBatch, range.end() - b)),
+                                                out.subspan(b), std::span(empty).subspan(b));
                           });
         GlobalTermStats stats;
         stats.queries = stats.evaluated = queries.size();
@@ -242,19 +240,50 @@ public:
     }
 
 private:
-    GlobalTerm evaluateOne(const GlobalTermQuery& q, bool& touched) const {
-        const Light::Path path = light_.pathFrom(q.position);
+    /// Queries evaluated together: the cache's lookups go as one batch
+    /// (LightSpaceCache::lookup), so that their memory latencies overlap.
+    static constexpr std::size_t kBatch = 64;
+
+    /// out[q] for each query q of the batch, and empty[q] = 1 where its path
+    /// toward the light crossed no hair.
+    void evaluateBatch(std::span<const GlobalTermQuery> queries, std::span<GlobalTerm> out,
+                       std::span<unsigned char> empty) const {
+        // Each path starts `start` from its point (the grid's start offset);
+        // a light nearer than that leaves the point unoccluded.
         const float start = model_.options().startOffset * static_cast<float>(model_.voxelSize());
-        if (!(path.distance > start))
-            return GlobalTerm::unoccluded();
-        OpticalDepths d;
-        if (cache_) {
-            d = cache_->lookup(q.position + start * path.omega);
-            touched = d.n > 0;
-        } else {
-            d = rates_->integrate(q.position, path.omega, start, path.distance, kOpaqueDepth,
-                                 touched);
+        std::array<Light::Path, kBatch> paths;
+        std::array<std::uint32_t, kBatch> open; // the queries with a path, in order
+        std::array<Vec3f, kBatch> from;
+        std::array<OpticalDepths, kBatch> depths;
+        std::size_t opened = 0;
+        for (std::size_t q = 0; q < queries.size(); ++q) {
+            paths[q] = light_.pathFrom(queries[q].position);
+            empty[q] = 1;
+            if (paths[q].distance > start) {
+                open[opened] = static_cast<std::uint32_t>(q);
+                from[opened++] = queries[q].position + start * paths[q].omega;
+            } else {
+                out[q] = GlobalTerm::unoccluded();
+            }
         }
+        if (cache_)
+            cache_->lookup(std::span(from).first(opened), std::span(depths).first(opened));
+        for (std::size_t k = 0; k < opened; ++k) {
+            const std::size_t q = open[k];
+            bool touched = false;
+            if (cache_)
+                touched = depths[k].n > 0;
+            else
+                depths[k] = rates_->integrate(queries[q].position, paths[q].omega, start,
+                                              paths[q].distance, kOpaqueDepth, touched);
+            out[q] = fromDepths(queries[q], paths[q], depths[k]);
+            empty[q] = touched ? 0 : 1;
+        }
+    }
+
+    /// The global term of query q from the optical depths along its path.
+    GlobalTerm fromDepths(const GlobalTermQuery& q, const Light::Path& path,
+                          const OpticalDepths& d) const {
         const float d_f = model_.settings().dualScattering.d_f;
         if (model_.mode() == GlobalTermMode::Grid)
             return globalTermFromDepths(d.n, d.tauP, d.sumBeta2, d_f);

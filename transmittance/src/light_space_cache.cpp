@@ -141,15 +141,15 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates, 
     }
     cache.lineRuns_.resize(lines + 1);
     cache.runs_.resize(runBase.back() + 1);
-    cache.samples_.resize(sampleBase.back());
+    cache.samples_ = LargeBuffer<Lanes>(sampleBase.back()); // written by the copies below
     tbb::parallel_for(std::size_t(0), blocks.size(), [&](std::size_t bi) {
         Block& block = blocks[bi];
         for (std::size_t j = 0; j < block.lineRuns.size(); ++j)
             cache.lineRuns_[bi * kLinesPerBlock + j] = runBase[bi] + block.lineRuns[j];
         for (std::size_t r = 0; r < block.runs.size(); ++r)
             cache.runs_[runBase[bi] + r] = {block.runs[r].k0, sampleBase[bi] + block.runs[r].begin};
-        std::copy(block.samples.begin(), block.samples.end(),
-                  cache.samples_.begin() + static_cast<std::ptrdiff_t>(sampleBase[bi]));
+        std::uninitialized_copy(block.samples.begin(), block.samples.end(),
+                                cache.samples_.begin() + sampleBase[bi]);
         block = Block{}; // freed as soon as copied
     });
     cache.lineRuns_[lines] = runBase.back();
@@ -161,7 +161,7 @@ std::size_t LightSpaceCache::sampleCount() const { return samples_.size(); }
 
 std::size_t LightSpaceCache::memoryBytes() const {
     return lineRuns_.capacity() * sizeof(std::uint64_t) + runs_.capacity() * sizeof(Run) +
-           samples_.capacity() * sizeof(Lanes);
+           samples_.bytes();
 }
 
 Vec3f LightSpaceCache::toLattice(const Vec3f& p) const {
@@ -184,8 +184,8 @@ Vec3f LightSpaceCache::lineOrigin(int i, int j, Vec3f& dir) const {
     return origin_ + sBase_ * dir;
 }
 
-Lanes LightSpaceCache::alongLine(std::size_t line, float s) const {
-    const std::uint64_t r0 = lineRuns_[line], r1 = lineRuns_[line + 1];
+LightSpaceCache::LineRead LightSpaceCache::alongLine(std::uint64_t r0, std::uint64_t r1,
+                                                    float s) const {
     if (r0 == r1 || s < float(runs_[r0].k0))
         return {}; // before the line's first change: zero
     // The last run starting at or before s (a line has a few).
@@ -198,35 +198,89 @@ Lanes LightSpaceCache::alongLine(std::size_t line, float s) const {
     const auto k = static_cast<std::size_t>(local);
     const Lanes* samples = samples_.data() + run.begin;
     if (k + 1 >= count)
-        return samples[count - 1]; // unchanged until the next run (or for good)
-    const float t = local - float(k);
-    const Lanes& a = samples[k];
-    const Lanes& b = samples[k + 1];
+        return {samples + (count - 1), nullptr, 0.0f}; // unchanged until the next run (or for good)
+    return {samples + k, samples + k + 1, local - float(k)};
+}
+
+Lanes LightSpaceCache::value(const LineRead& read) {
+    if (!read.a)
+        return {};
+    if (!read.b)
+        return *read.a;
     Lanes result;
     for (int lane = 0; lane < 8; ++lane)
-        result.v[lane] = a.v[lane] + t * (b.v[lane] - a.v[lane]);
+        result.v[lane] = read.a->v[lane] + read.t * (read.b->v[lane] - read.a->v[lane]);
     return result;
 }
 
-OpticalDepths LightSpaceCache::lookup(const Vec3f& p) const {
-    if (lineCount() == 0)
-        return {};
-    const Vec3f l = toLattice(p);
-    const float fi = std::floor(l.x), fj = std::floor(l.y);
-    const int i = static_cast<int>(fi), j = static_cast<int>(fj);
-    const float tx = l.x - fi, ty = l.y - fj;
-    Lanes r;
-    for (int k = 0; k < 4; ++k) {
-        const int ii = i + (k & 1), jj = j + (k >> 1);
-        if (ii < 0 || jj < 0 || ii >= ni_ || jj >= nj_)
-            continue;
-        const float w = ((k & 1) ? tx : 1.0f - tx) * ((k >> 1) ? ty : 1.0f - ty);
-        const Lanes s =
-            alongLine(static_cast<std::size_t>(jj) * std::size_t(ni_) + std::size_t(ii), l.z);
-        for (int lane = 0; lane < 8; ++lane)
-            r.v[lane] += w * s.v[lane];
+void LightSpaceCache::lookup(std::span<const Vec3f> points, std::span<OpticalDepths> out) const {
+    if (lineCount() == 0) {
+        std::fill(out.begin(), out.end(), OpticalDepths{});
+        return;
     }
-    return r.depths();
+    // 16 points × 4 lines: 64 reads in flight per step, as many as the
+    // cores' miss queues take.
+    constexpr std::size_t kBatch = 16;
+    struct Corner {
+        bool inside = false;
+        float w = 0;
+        std::size_t line = 0;
+        std::uint64_t r0 = 0, r1 = 0; ///< its runs
+        LineRead read;
+    };
+    std::array<std::array<Corner, 4>, kBatch> corners;
+    std::array<float, kBatch> s;
+    for (std::size_t b = 0; b < points.size(); b += kBatch) {
+        const std::size_t n = std::min(kBatch, points.size() - b);
+        // 1. The 4 lines around each point (bilinear weights); their runs' index.
+        for (std::size_t q = 0; q < n; ++q) {
+            const Vec3f l = toLattice(points[b + q]);
+            const float fi = std::floor(l.x), fj = std::floor(l.y);
+            const int i = static_cast<int>(fi), j = static_cast<int>(fj);
+            const float tx = l.x - fi, ty = l.y - fj;
+            s[q] = l.z;
+            for (int k = 0; k < 4; ++k) {
+                Corner& c = corners[q][std::size_t(k)];
+                const int ii = i + (k & 1), jj = j + (k >> 1);
+                c.inside = ii >= 0 && jj >= 0 && ii < ni_ && jj < nj_;
+                if (!c.inside)
+                    continue;
+                c.w = ((k & 1) ? tx : 1.0f - tx) * ((k >> 1) ? ty : 1.0f - ty);
+                c.line = static_cast<std::size_t>(jj) * std::size_t(ni_) + std::size_t(ii);
+                __builtin_prefetch(&lineRuns_[c.line]);
+            }
+        }
+        // 2. Each line's runs.
+        for (std::size_t q = 0; q < n; ++q)
+            for (Corner& c : corners[q])
+                if (c.inside) {
+                    c.r0 = lineRuns_[c.line];
+                    c.r1 = lineRuns_[c.line + 1];
+                    __builtin_prefetch(&runs_[c.r0]);
+                }
+        // 3. The run at s, and where its samples are.
+        for (std::size_t q = 0; q < n; ++q)
+            for (Corner& c : corners[q])
+                if (c.inside) {
+                    c.read = alongLine(c.r0, c.r1, s[q]);
+                    if (c.read.a)
+                        __builtin_prefetch(c.read.a);
+                    if (c.read.b)
+                        __builtin_prefetch(c.read.b);
+                }
+        // 4. The values, summed in the corners' order.
+        for (std::size_t q = 0; q < n; ++q) {
+            Lanes r;
+            for (const Corner& c : corners[q]) {
+                if (!c.inside)
+                    continue;
+                const Lanes v = value(c.read);
+                for (int lane = 0; lane < 8; ++lane)
+                    r.v[lane] += c.w * v.v[lane];
+            }
+            out[b + q] = r.depths();
+        }
+    }
 }
 
 } // namespace hairvox::detail

@@ -24,6 +24,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <vector>
 
 namespace hairvox::detail {
@@ -36,8 +37,14 @@ public:
     static std::optional<LightSpaceCache> build(const BrickVolume& rates, const Light& light,
                                                 float opaqueDepth, float spacing);
 
-    /// The integral from p to the light.
-    OpticalDepths lookup(const Vec3f& p) const;
+    /// The integrals from each of `points` to the light (out: one per point).
+    /// Each interpolates its 4 surrounding lines, and a line's read is three
+    /// dependent loads (its runs' index, its run, two samples), each a likely
+    /// cache miss in a cache of tens of MB: the points go in batches that take
+    /// each step together, prefetching the next step's loads, so that the
+    /// misses of different points overlap. A point's value does not depend on
+    /// the others.
+    void lookup(std::span<const Vec3f> points, std::span<OpticalDepths> out) const;
 
     std::size_t lineCount() const { return std::size_t(ni_) * std::size_t(nj_); }
     /// Samples stored over every line.
@@ -49,8 +56,18 @@ private:
     Vec3f toLattice(const Vec3f& p) const;
     /// A point of line (i, j) at lattice distance s.
     Vec3f lineOrigin(int i, int j, Vec3f& dir) const;
-    /// The stored integral of line `line` at lattice distance s.
-    Lanes alongLine(std::size_t line, float s) const;
+    /// Where the stored integral of a line is read at a lattice distance:
+    /// samples a and b (b = a + 1) mixed by t, or sample a alone (b null),
+    /// or zero (a null: before the line's first change).
+    struct LineRead {
+        const Lanes* a = nullptr;
+        const Lanes* b = nullptr;
+        float t = 0;
+    };
+    /// The read at lattice distance s of the line whose runs are runs_[r0, r1).
+    LineRead alongLine(std::uint64_t r0, std::uint64_t r1, float s) const;
+    /// The value a read gives.
+    static Lanes value(const LineRead& read);
 
     /// Samples k0, k0 + 1, ... of a line, stored from samples_[begin] up to
     /// the next run's begin.
@@ -66,9 +83,9 @@ private:
     float h_ = 1;     ///< spacing along lines (world)
     float sBase_ = 0; ///< world distance of lattice s = 0 from the light plane/point
     int i0_ = 0, j0_ = 0, ni_ = 0, nj_ = 0; ///< line lattice [i0, i0 + ni) × [j0, j0 + nj)
-    std::vector<std::uint64_t> lineRuns_; ///< line l's runs are runs_[lineRuns_[l], lineRuns_[l + 1])
-    std::vector<Run> runs_;               ///< and a sentinel whose begin is samples_.size()
-    LargeVector<Lanes> samples_; ///< on huge pages: queries read it scattered
+    LargeVector<std::uint64_t> lineRuns_; ///< line l's runs are runs_[lineRuns_[l], lineRuns_[l + 1])
+    LargeVector<Run> runs_;               ///< and a sentinel whose begin is samples_.size()
+    LargeBuffer<Lanes> samples_; ///< on huge pages: queries read it scattered
 };
 
 } // namespace hairvox::detail

@@ -27,6 +27,7 @@
 // so that a read before the first write shows in the tests.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <memory>
 #include <new>
@@ -83,5 +84,62 @@ bool operator==(const LargeArrayAllocator<T>&, const LargeArrayAllocator<U>&) no
 /// default-initialised.
 template <typename T>
 using LargeVector = std::vector<T, LargeArrayAllocator<T>>;
+
+/// A fixed-size array on huge pages whose elements its producer creates, for
+/// element types with default member initialisers (Rgb, the global term's
+/// 8-lane values): LargeVector's resize(n) runs those initialisers, a write
+/// of every page on the calling thread. Here nothing is written until the
+/// producer fills the elements (std::uninitialized_fill, _copy, ... from its
+/// threads) before anything reads them; the sanitizer builds poison them as
+/// allocateLarge() does. T is trivially copyable and destructible, so that
+/// neither creating nor discarding its elements has effects to skip.
+template <typename T>
+class LargeBuffer {
+    static_assert(std::is_trivially_copyable_v<T> && std::is_trivially_destructible_v<T>);
+
+public:
+    LargeBuffer() = default;
+    explicit LargeBuffer(std::size_t n)
+        : size_(n) {
+        if (n > std::size_t(-1) / sizeof(T))
+            throw std::bad_array_new_length();
+        data_.reset(static_cast<T*>(allocateLarge(bytes(), alignof(T))));
+        data_.get_deleter().bytes = bytes();
+    }
+    /// n copies of `value`, written on the calling thread.
+    LargeBuffer(std::size_t n, const T& value)
+        : LargeBuffer(n) {
+        std::uninitialized_fill(begin(), end(), value);
+    }
+    LargeBuffer(LargeBuffer&& o) noexcept
+        : data_(std::move(o.data_))
+        , size_(std::exchange(o.size_, 0)) {}
+    LargeBuffer& operator=(LargeBuffer&& o) noexcept {
+        data_ = std::move(o.data_);
+        size_ = std::exchange(o.size_, 0);
+        return *this;
+    }
+
+    std::size_t size() const { return size_; }
+    bool empty() const { return size_ == 0; }
+    T* data() { return data_.get(); }
+    const T* data() const { return data_.get(); }
+    T* begin() { return data(); }
+    T* end() { return data() + size_; }
+    const T* begin() const { return data(); }
+    const T* end() const { return data() + size_; }
+    T& operator[](std::size_t i) { return data_[i]; }
+    const T& operator[](std::size_t i) const { return data_[i]; }
+    /// Bytes allocated (without the huge-page rounding).
+    std::size_t bytes() const { return std::max<std::size_t>(size_, 1) * sizeof(T); }
+
+private:
+    struct Delete {
+        std::size_t bytes; ///< (no initialiser: GCC would not see the deleter as default-constructible)
+        void operator()(T* p) const noexcept { deallocateLarge(p, bytes, alignof(T)); }
+    };
+    std::unique_ptr<T[], Delete> data_;
+    std::size_t size_ = 0;
+};
 
 } // namespace hairvox

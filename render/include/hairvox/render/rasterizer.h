@@ -70,7 +70,7 @@ struct SurfaceLayer {
     // (core/large_array.h: pipeline/surfaces.cpp fills them on its threads.)
     LargeVector<float> coverage; ///< [0, 1]; 0 where no surface
     LargeVector<float> depth;
-    LargeVector<Rgb> radiance;
+    LargeBuffer<Rgb> radiance;
 
     bool empty() const { return coverage.empty(); }
 };
