@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <memory>
 #include <fstream>
 #include <numeric>
 #include <sstream>
@@ -53,6 +54,32 @@ TEST(LargeArray, BehavesAsAVectorAcrossGrowth) {
     EXPECT_EQ(std::accumulate(v.begin(), v.end(), 0u), 70u);
     LargeVector<float> w(1000, 0.5f); // so does construction from a value
     EXPECT_EQ(std::accumulate(w.begin(), w.end(), 0.0f), 500.0f);
+}
+
+TEST(LargeArray, BufferHoldsWhatItsProducerWritesAndMovesOut) {
+    struct Lanes3 {
+        float v[3] = {1, 2, 3}; // default member initialisers: not run by LargeBuffer(n)
+    };
+    LargeBuffer<Lanes3> empty;
+    EXPECT_TRUE(empty.empty());
+    EXPECT_EQ(empty.begin(), empty.end());
+
+    const std::size_t n = kHugePageBytes / sizeof(Lanes3) + 10; // a huge-page block
+    LargeBuffer<Lanes3> a(n);
+    ASSERT_EQ(a.size(), n);
+    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(a.data()) % kHugePageBytes, 0u);
+    std::uninitialized_fill(a.begin(), a.end(), Lanes3{{4, 5, 6}});
+    EXPECT_EQ(a[n - 1].v[2], 6.0f);
+
+    LargeBuffer<Lanes3> b = std::move(a);
+    EXPECT_EQ(b.size(), n);
+    EXPECT_EQ(b[0].v[0], 4.0f);
+    EXPECT_TRUE(a.empty()); // NOLINT(bugprone-use-after-move): moved-from is empty
+    EXPECT_EQ(a.data(), nullptr);
+
+    const LargeBuffer<float> c(1000, 0.5f); // (n, value) writes
+    EXPECT_EQ(std::accumulate(c.begin(), c.end(), 0.0f), 500.0f);
+    EXPECT_EQ(c.bytes(), 1000 * sizeof(float));
 }
 
 TEST(LargeArray, LargeBlocksAreHugePageAlignedAndAdvised) {

@@ -8,7 +8,10 @@
 
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <span>
 
 namespace hairvox {
 namespace {
@@ -166,6 +169,39 @@ TEST(GridGlobalTerm, CacheStoresNothingAcrossEmptySpaceAndAgreesWithTheMarch) {
     EXPECT_LT(double(held[1]), 1.3 * double(held[0]))
         << "the cache grew with the empty space between the slabs: " << held[0] << " -> "
         << held[1] << " bytes";
+}
+
+TEST(GridGlobalTerm, AQueryDoesNotDependOnItsBatch) {
+    // The cache's lookups go in batches that prefetch together
+    // (LightSpaceCache::lookup): a query's value must be the one it gets
+    // alone, to the bit, wherever it falls in a batch (200 queries span
+    // several, the last one partial), and whether or not its light is
+    // nearer than the start offset (a point light among the fibers).
+    const test::Slab slab;
+    const FiberGrid grid = splat(slab.groom(), 0.002);
+    const auto model = makeGridModel(grid, {constantTable(0.5f, 0.01f)}, slabSettings(), {});
+    std::vector<GlobalTermQuery> queries;
+    Pcg32 rng(11);
+    for (int i = 0; i < 203; ++i)
+        queries.push_back({Vec3f(rng.uniform(-0.01f, 0.01f), rng.uniform(-0.004f, 0.012f),
+                                 rng.uniform(-0.03f, 0.03f)),
+                           Vec3f(1, 0, 0)});
+    for (const Light& light : {Light::directional(glm::normalize(Vec3f(0.2f, 1, 0.1f))),
+                               Light::point(queries[7].position)}) {
+        const auto term = model->forLight(light);
+        std::vector<GlobalTerm> together(queries.size());
+        term->evaluate(queries, together);
+        for (std::size_t i = 0; i < queries.size(); ++i) {
+            GlobalTerm alone;
+            term->evaluate(std::span(queries).subspan(i, 1), std::span(&alone, 1));
+            ASSERT_EQ(std::bit_cast<std::uint32_t>(alone.n), std::bit_cast<std::uint32_t>(together[i].n))
+                << "query " << i << " at " << queries[i].position;
+            for (int c = 0; c < 3; ++c)
+                ASSERT_EQ(std::bit_cast<std::uint32_t>(alone.P[c]),
+                          std::bit_cast<std::uint32_t>(together[i].P[c]))
+                    << "query " << i << " channel " << c;
+        }
+    }
 }
 
 TEST(GridGlobalTerm, PoissonKeepsTransmittanceNonNegativeWhereGeometricCannot) {

@@ -218,8 +218,8 @@ void LightSpaceCache::lookup(std::span<const Vec3f> points, std::span<OpticalDep
         std::fill(out.begin(), out.end(), OpticalDepths{});
         return;
     }
-    // 16 points × 4 lines: 64 reads in flight per step, as many as the
-    // cores' miss queues take.
+    // 16 points × 4 lines a step (batches of 8 and 32 measured the same,
+    // transmittance_bench GridLookup: 51-65 ns a query; one by one, 166 ns).
     constexpr std::size_t kBatch = 16;
     struct Corner {
         bool inside = false;
