@@ -8,21 +8,30 @@
 //   BM_DependentLoad      a pointer chase through a random cycle of 256 MiB: the
 //                         latency of one cache miss (ns_per_load), 1 chain and
 //                         8 independent chains (what overlapping misses buys)
+//   BM_FirstTouch         mapping 256 MiB on huge pages and writing a byte per
+//                         4 KiB page (the kernel zeroes each page as it is first
+//                         written), then unmapping it: bytes_per_second of first
+//                         touch. arg 0: back to back, the pages the last
+//                         iteration freed; arg 1: 5 s apart, so that a guest
+//                         whose balloon reports free pages to its host has
+//                         given them back (DESIGN §7: 14 against 0.63 GB/s here)
 //   BM_PeakFma            independent multiply-adds: scalar double, unfused (the
 //                         x86-64 baseline the raster is compiled for), and 16-wide
 //                         float FMA (AVX-512, the shader's dispatch): FLOP/s
 //                         (flops_per_second)
 //
-//   machine_bench                      # everything (≈ 20 s)
+//   machine_bench                      # everything (≈ 40 s)
 #include <benchmark/benchmark.h>
 
 #include <immintrin.h>
+#include <sys/mman.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <numeric>
 #include <random>
+#include <thread>
 #include <vector>
 
 namespace {
@@ -84,6 +93,45 @@ void BM_DependentLoad(benchmark::State& state) {
     state.counters["ns_per_load"] = 1e9 * seconds / loads;
 }
 BENCHMARK(BM_DependentLoad)->Arg(1)->Arg(8)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+/// Maps 256 MiB on huge pages, writes a byte per 4 KiB page, unmaps it; false
+/// if the mapping failed.
+bool touchFreshMemory() {
+    constexpr std::size_t kBytes = std::size_t(256) << 20, kHuge = std::size_t(2) << 20;
+    void* mapped =
+        ::mmap(nullptr, kBytes + kHuge, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (mapped == MAP_FAILED)
+        return false;
+    const auto aligned = (reinterpret_cast<std::uintptr_t>(mapped) + kHuge - 1) & ~(kHuge - 1);
+    ::madvise(reinterpret_cast<void*>(aligned), kBytes, MADV_HUGEPAGE);
+    auto* p = reinterpret_cast<volatile char*>(aligned);
+    for (std::size_t i = 0; i < kBytes; i += 4096)
+        p[i] = 1;
+    ::munmap(mapped, kBytes + kHuge);
+    return true;
+}
+
+/// arg 0: the pages just freed again (after one untimed round); arg 1: after
+/// 5 s idle each time (see the header).
+void BM_FirstTouch(benchmark::State& state) {
+    const bool idle = state.range(0) == 1;
+    if (!idle && !touchFreshMemory())
+        state.SkipWithError("mmap failed");
+    for (auto _ : state) {
+        if (idle) {
+            state.PauseTiming();
+            std::this_thread::sleep_for(std::chrono::seconds(5));
+            state.ResumeTiming();
+        }
+        if (!touchFreshMemory()) {
+            state.SkipWithError("mmap failed");
+            return;
+        }
+    }
+    state.SetBytesProcessed(state.iterations() * (std::int64_t(256) << 20));
+}
+BENCHMARK(BM_FirstTouch)->Arg(0)->Iterations(10)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FirstTouch)->Arg(1)->Iterations(3)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 constexpr int kFmaChains = 16; // independent accumulators: more than latency × issue width
 constexpr int kFmaSteps = 1 << 22;
