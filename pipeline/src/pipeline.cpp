@@ -362,7 +362,8 @@ SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& opti
         }
         report.prepareSeconds = secondsSince(start);
     });
-    result.times.globalTerm += secondsSince(prepareStart);
+    result.globalTermPrepareSeconds = secondsSince(prepareStart);
+    result.times.globalTerm += result.globalTermPrepareSeconds;
 
     // The surfaces as the camera sees them, lit through the hair.
     const Camera camera(scene.camera);
@@ -717,8 +718,11 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
             std::snprintf(line, sizeof(line), "%s %.3f s", l.name.c_str(), l.prepareSeconds);
             prepared += (prepared.empty() ? "" : ", ") + std::string(line);
         }
-    if (!prepared.empty() && scene.globalTermMode != GlobalTermMode::Exact)
-        more("prepared per light, concurrently: " + prepared);
+    if (!prepared.empty() && scene.globalTermMode != GlobalTermMode::Exact) {
+        std::snprintf(line, sizeof(line), "%.3f s preparing the lights (concurrently: ",
+                      r.globalTermPrepareSeconds);
+        more(line + prepared + "); the rest: lookups while shading");
+    }
     row("raster", r.times.raster,
         thousands(st.fragments) + " fragments; skipped: " + thousands(st.segmentsOutsideView) +
             " segments outside the view, " + thousands(st.segmentTilesBehindSurfaces) +

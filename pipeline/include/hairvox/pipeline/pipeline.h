@@ -150,6 +150,9 @@ struct SceneRender {
     std::vector<std::string> warnings;       ///< for the user (rejected shader results, ...)
     StageTimes times;
     std::vector<LightReport> lights;
+    /// Of times.globalTerm, the lights' preparation (wall time, the lights
+    /// concurrently); the rest is the lookups made while shading.
+    double globalTermPrepareSeconds = 0;
     std::vector<std::filesystem::path> written;
     std::uint64_t activeVoxels = 0; ///< of the fiber grid (0 in exact mode)
     std::uint64_t surfaceTriangles = 0; ///< of the scene's meshes
