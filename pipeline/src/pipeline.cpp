@@ -652,7 +652,8 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
         std::snprintf(line, sizeof(line), "  %-12s %7.3f s  %s\n", stage, seconds, detail.c_str());
         os << line;
     };
-    // A further line of the stage above: no time of its own.
+    // A further line of the stage above, under row()'s detail column
+    // ("  " + 12 + " " + "%7.3f s" + "  "): no time of its own.
     const auto more = [&](const std::string& detail) { os << std::string(26, ' ') << detail << '\n'; };
     std::string written;
     for (const auto& p : r.written)
