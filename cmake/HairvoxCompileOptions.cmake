@@ -53,3 +53,12 @@ function(hairvox_add_library name)
     target_link_libraries(hairvox_${name} PUBLIC ${ARG_PUBLIC_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
     hairvox_target_defaults(hairvox_${name})
 endfunction()
+
+# hairvox_use_process_allocator(target): a program (never a library) links the
+# process allocator, jemalloc configured by core/src/process_allocator.cpp,
+# where HAIRVOX_JEMALLOC is on.
+function(hairvox_use_process_allocator target)
+    if(HAIRVOX_JEMALLOC)
+        target_link_libraries(${target} PRIVATE hairvox_process_allocator ${JEMALLOC_LIBRARY})
+    endif()
+endfunction()

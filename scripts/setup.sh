@@ -9,7 +9,7 @@ packages=(
   libopenvdb-dev libnanovdb-dev libopenvdb-tools python3-openvdb
   libboost-iostreams-dev libblosc-dev zlib1g-dev
   libopenexr-dev libimath-dev openexr libpng-dev
-  libembree-dev libtinyobjloader-dev libhwy-dev
+  libembree-dev libtinyobjloader-dev libhwy-dev libjemalloc-dev
   libgtest-dev libbenchmark-dev
   clang libclang-rt-14-dev
   python3-numpy python3-matplotlib

@@ -78,6 +78,33 @@ bool boxBitSet(const std::vector<std::uint64_t>& bits, const glm::ivec3& c, cons
     return (bits[bit >> 6] >> (bit & 63)) & 1u;
 }
 
+/// The boxes of the set cells of an 8³ cell mask (bit x·64 + y·8 + z) in
+/// each of its 2³ octants of 4³ cells (octant ((x/4)·2 + y/4)·2 + z/4); lo > hi
+/// in an octant with none.
+template <typename Boxes>
+Boxes octantBoxes(const std::array<std::uint64_t, 8>& mask) {
+    Boxes result;
+    auto& boxes = result.box;
+    boxes.fill({{8, 8, 8}, {0, 0, 0}});
+    for (int x = 0; x < 8; ++x)
+        for (std::uint64_t word = mask[std::size_t(x)]; word != 0; word &= word - 1) {
+            const int bit = std::countr_zero(word);
+            const std::array<int, 3> c{x, bit >> 3, bit & 7};
+            auto& box = boxes[std::size_t(((c[0] >> 2) * 2 + (c[1] >> 2)) * 2 + (c[2] >> 2))];
+            for (std::size_t a = 0; a < 3; ++a) {
+                box.lo[a] = std::min(box.lo[a], static_cast<std::uint8_t>(c[a]));
+                box.hi[a] = std::max(box.hi[a], static_cast<std::uint8_t>(c[a]));
+            }
+        }
+    result.whole = true;
+    for (std::size_t o = 0; o < 8; ++o)
+        for (std::size_t a = 0; a < 3; ++a) {
+            const int lo = (o >> (2 - a) & 1) ? 4 : 0; // the octant's own cells
+            result.whole = result.whole && boxes[o].lo[a] == lo && boxes[o].hi[a] == lo + 3;
+        }
+    return result;
+}
+
 } // namespace
 
 const Lanes BrickVolume::kZero{};
@@ -91,8 +118,45 @@ std::size_t BrickVolume::memoryBytes() const {
     return values_.size() * sizeof(Lanes) + present_.capacity() * sizeof(SlotBits) +
            valueBase_.capacity() * sizeof(std::size_t) +
            cellMask_.capacity() * sizeof(cellMask_[0]) +
+           cellBoxes_.capacity() * sizeof(OctantBoxes) +
            (occupancy_.capacity() + superOccupancy_.capacity()) * sizeof(std::uint64_t) +
            brickCoord_.capacity() * sizeof(glm::ivec3) + slots_.capacity() * sizeof(std::int64_t);
+}
+
+bool BrickVolume::mayMeetValues(std::size_t brick, const glm::ivec3& b,
+                                const GridLine<float>& line, float s0, float s1) const {
+    const OctantBoxes& boxes = cellBoxes_[brick];
+    if (boxes.whole)
+        return true;
+    const glm::ivec3 base = kBrick * b;
+    // The walk's crossings are exact to a few ulps of the index coordinates:
+    // 1/64 of a cell, more where the coordinates are large.
+    const int magnitude = std::max({std::abs(base.x), std::abs(base.y), std::abs(base.z)}) + kBrick;
+    const float margin = 1.0f / 64.0f + 64.0f * std::numeric_limits<float>::epsilon() *
+                                            static_cast<float>(magnitude);
+    for (const CellBox& box : boxes.box) {
+        if (box.lo[0] > box.hi[0])
+            continue; // an octant without such cells
+        float sa = s0, sb = s1;
+        for (std::size_t a = 0; a < 3 && sa <= sb; ++a) {
+            const int i = static_cast<int>(a);
+            const float lo = static_cast<float>(base[i] + box.lo[a]) - margin;
+            const float hi = static_cast<float>(base[i] + box.hi[a] + 1) + margin;
+            if (line.invDir[i] == 0.0f) { // the walk does not move along a
+                const float x = line.origin[i] + s0 * line.dir[i];
+                if (x < lo || x > hi)
+                    sb = -kInfinity;
+                continue;
+            }
+            const float ta = (lo - line.origin[i]) * line.invDir[i];
+            const float tb = (hi - line.origin[i]) * line.invDir[i];
+            sa = std::max(sa, std::min(ta, tb));
+            sb = std::min(sb, std::max(ta, tb));
+        }
+        if (sa <= sb)
+            return true;
+    }
+    return false;
 }
 
 std::int64_t BrickVolume::find(const glm::ivec3& b) const {
@@ -171,6 +235,7 @@ void BrickVolume::allocateValues() {
     // any thread count), then the bricks' runs are laid end to end.
     std::vector<std::size_t> counts(brickCount_);
     cellMask_.assign(brickCount_, {});
+    cellBoxes_.resize(brickCount_);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, brickCount_, 64), [&](const auto& r) {
         for (std::size_t brick = r.begin(); brick != r.end(); ++brick) {
             SlotBits& slots = present_[brick];
@@ -191,6 +256,7 @@ void BrickVolume::allocateValues() {
                 }
             }
             counts[brick] = next;
+            cellBoxes_[brick] = octantBoxes<OctantBoxes>(cellMask_[brick]);
         }
     });
     valueBase_.resize(brickCount_);
@@ -282,14 +348,13 @@ void BrickVolume::walkBricks(const Vec3f& O, const Vec3f& dir, float s0, float s
 }
 
 template <typename NextSplit, typename OnPiece>
-void BrickVolume::forEachPiece(std::size_t brick, const glm::ivec3& b, const Vec3f& O,
-                               const Vec3f& dir, float sa, float sb, NextSplit&& nextSplit,
-                               OnPiece&& onPiece) const {
+void BrickVolume::forEachPiece(std::size_t brick, const glm::ivec3& b, const GridLine<float>& line,
+                               float sa, float sb, NextSplit&& nextSplit, OnPiece&& onPiece) const {
     const glm::ivec3 base = kBrick * b;
     // The field is continuous: a piece's end value is the next piece's start value.
     Lanes fStart;
     bool haveStart = false;
-    traverseCells(GridLine<float>(O, dir), sa, sb, base, base + (kBrick - 1),
+    traverseCells(line, sa, sb, base, base + (kBrick - 1),
                   [&](const glm::ivec3& cell, float s, float sEnd) {
                       const glm::ivec3 l = cell - base;
                       if (!((cellMask_[brick][std::size_t(l.x)] >> (l.y * 8 + l.z)) & 1u)) {
@@ -311,7 +376,7 @@ void BrickVolume::forEachPiece(std::size_t brick, const glm::ivec3& b, const Vec
                       }
                       const Vec3f cf(cell);
                       const auto at = [&](float t) {
-                          return trilinear(corner, O + t * dir - cf);
+                          return trilinear(corner, line.at(t) - cf);
                       };
                       if (!haveStart)
                           fStart = at(s);
@@ -335,11 +400,14 @@ OpticalDepths BrickVolume::integrate(const Vec3f& origin, const Vec3f& dir, floa
     const float opaqueSum = opaqueDepth * invH_;
     Lanes sum;
     touched = false;
+    const GridLine<float> line(O, dir);
     walkBricks(O, dir, tStart * invH_, std::isinf(tEnd) ? kInfinity : tEnd * invH_,
                [&](std::size_t brick, const glm::ivec3& b, float s, float sExit) {
                    touched = true;
+                   if (!mayMeetValues(brick, b, line, s, sExit))
+                       return true;
                    forEachPiece(
-                       brick, b, O, dir, s, sExit, [](float) { return kInfinity; },
+                       brick, b, line, s, sExit, [](float) { return kInfinity; },
                        [&](float s0, float s1, const Lanes& f0, const Lanes& fm, const Lanes& f1) {
                            addSimpson(sum, f0, fm, f1, (s1 - s0) / 6.0f);
                        });
@@ -387,19 +455,30 @@ void BrickVolume::integrateCumulative(const Vec3f& origin, const Vec3f& dir, flo
         next = std::max(next, k);
     };
     bool opaque = false;
+    const GridLine<float> line(O, dir);
     walkBricks(O, dir, sStart, position(count - 1),
                [&](std::size_t brick, const glm::ivec3& b, float s, float sExit) {
+                   // A brick the line crosses no value's cell of leaves the
+                   // sum and what is recorded as they were (the samples it
+                   // would record repeat the last value; the next brick's
+                   // skipTo records the same ones either side of a change).
+                   if (!mayMeetValues(brick, b, line, s, sExit))
+                       return true;
                    skipTo(s);
                    recordUpTo(s);
                    // Pieces end at sample positions, where the running sum is recorded.
                    forEachPiece(
-                       brick, b, O, dir, s, sExit,
+                       brick, b, line, s, sExit,
                        [&](float t) {
                            const float k = std::floor((t - sStart) / sStep) + 1.0f;
                            const float split = sStart + k * sStep;
                            return split > t ? split : split + sStep; // rounding at a sample
                        },
                        [&](float s0, float s1, const Lanes& f0, const Lanes& fm, const Lanes& f1) {
+                           // The samples up to the piece hold the sum before it:
+                           // those between the brick's entry and its first cell
+                           // with values are recorded here, not after it.
+                           recordUpTo(s0);
                            addSimpson(sum, f0, fm, f1, (s1 - s0) / 6.0f);
                            recordUpTo(s1);
                        });

@@ -18,9 +18,12 @@
 // 25 active voxels per 8³ brick), where dense 9³ bricks cost 0.9 KB per active
 // voxel and grew as the square of the resolution, and a 16-bit index per slot
 // still cost 1.46 KB a brick. A line's walk skips empty space a super-brick
-// (4³ bricks) at a time.
+// (4³ bricks) at a time, and passes a brick without walking its cells where
+// it misses the boxes of the cells that hold a value in each of the brick's
+// octants (at 0.5 mm, 75% of the bricks a lattice line enters on Ratboy).
 #pragma once
 
+#include <hairvox/core/grid_traversal.h>
 #include <hairvox/core/large_array.h>
 #include <hairvox/core/rgb.h>
 #include <hairvox/core/vecmath.h>
@@ -122,8 +125,8 @@ public:
     };
     /// Cumulative integrals along origin + t·dir at t_k = tStart + k·step,
     /// k = 0 .. count − 1, recorded sparsely: `out` gets, in increasing k, the
-    /// samples from the last one before the line enters a brick to the last
-    /// one before it leaves it. A sample not recorded holds the value of the
+    /// samples from the last one before the line enters a brick whose values
+    /// it meets to the last one before it leaves it. A sample not recorded holds the value of the
     /// one recorded before it (the integral does not change outside bricks),
     /// and 0 before the first. Stops once n and every channel of tauP exceed
     /// `opaqueDepth` (later samples would only grow). Work and output follow
@@ -148,8 +151,15 @@ private:
     /// with the field at each piece's ends and middle (nothing for cells whose
     /// corners are all zero).
     template <typename NextSplit, typename OnPiece>
-    void forEachPiece(std::size_t brick, const glm::ivec3& b, const Vec3f& O, const Vec3f& dir,
+    void forEachPiece(std::size_t brick, const glm::ivec3& b, const GridLine<float>& line,
                       float sa, float sb, NextSplit&& nextSplit, OnPiece&& onPiece) const;
+    /// Whether the cell walk of `line` over s ∈ [s0, s1) through brick
+    /// `brick` (at brick coordinate b) may enter a cell a value is a corner
+    /// of: false only where it cannot (the line misses the box of those
+    /// cells, widened against rounding), so that skipping the brick leaves
+    /// every result as it was.
+    bool mayMeetValues(std::size_t brick, const glm::ivec3& b, const GridLine<float>& line,
+                       float s0, float s1) const;
     /// Index of the brick at brick coordinate b, or −1.
     std::int64_t find(const glm::ivec3& b) const;
     /// Whether brick b exists, from the occupancy bits (no hashing): what a
@@ -204,6 +214,18 @@ private:
     /// Per brick, one bit per cell (x·64 + y·8 + z) set where a corner of the
     /// cell holds a value: a line's walk skips the other cells on one test.
     std::vector<std::array<std::uint64_t, 8>> cellMask_;
+    /// Per brick and octant of 4³ cells, the box of those cells: local cell
+    /// coordinates lo..hi per axis (lo > hi where the octant has none).
+    struct CellBox {
+        std::array<std::uint8_t, 3> lo, hi;
+    };
+    struct OctantBoxes {
+        std::array<CellBox, 8> box;
+        /// Every box is its whole octant (a dense brick): any line through
+        /// the brick meets one, and the test is skipped.
+        bool whole = false;
+    };
+    std::vector<OctantBoxes> cellBoxes_;
     /// The packed values of every brick, once allocateValues() has run.
     LargeBuffer<Lanes> values_;
     glm::ivec3 brickMin_{0}, brickMax_{-1};

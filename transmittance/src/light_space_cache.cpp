@@ -86,28 +86,32 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates, 
     const auto samplesPerLine =
         static_cast<std::size_t>(std::ceil((sMaxWorld - cache.sBase_) / cache.h_)) + 2;
 
-    // Lines are integrated in blocks, one task each, then laid end to end.
-    constexpr std::size_t kLinesPerBlock = 256;
+    // Lines are integrated a tile a task, then laid end to end.
+    cache.tilesPerRow_ = static_cast<std::size_t>((cache.ni_ + kTile - 1) / kTile);
+    const std::size_t tileCount =
+        cache.tilesPerRow_ * static_cast<std::size_t>((cache.nj_ + kTile - 1) / kTile);
+    constexpr std::size_t kLinesPerTile = std::size_t(kTile) * kTile;
     struct Block {
         std::vector<std::uint64_t> lineRuns; ///< per line of the block, into runs
         std::vector<Run> runs;               ///< begin: into samples
         std::vector<Lanes> samples;
     };
-    const std::size_t lines = cache.lineCount();
-    std::vector<Block> blocks((lines + kLinesPerBlock - 1) / kLinesPerBlock);
+    std::vector<Block> blocks(tileCount);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks.size()), [&](const auto& range) {
         std::vector<BrickVolume::CumulativeSample> recorded;
         for (std::size_t bi = range.begin(); bi != range.end(); ++bi) {
             Block& block = blocks[bi];
-            const std::size_t first = bi * kLinesPerBlock;
-            const std::size_t end = std::min(first + kLinesPerBlock, lines);
-            block.lineRuns.reserve(end - first);
-            for (std::size_t line = first; line != end; ++line) {
+            block.lineRuns.reserve(kLinesPerTile);
+            const int tileI = static_cast<int>(bi % cache.tilesPerRow_) * kTile;
+            const int tileJ = static_cast<int>(bi / cache.tilesPerRow_) * kTile;
+            for (std::size_t l = 0; l < kLinesPerTile; ++l) {
                 block.lineRuns.push_back(block.runs.size());
+                const int li = tileI + static_cast<int>(l % kTile);
+                const int lj = tileJ + static_cast<int>(l / kTile);
+                if (li >= cache.ni_ || lj >= cache.nj_)
+                    continue; // padding
                 Vec3f dir;
-                const Vec3f origin = cache.lineOrigin(static_cast<int>(line % std::size_t(cache.ni_)),
-                                                      static_cast<int>(line / std::size_t(cache.ni_)),
-                                                      dir);
+                const Vec3f origin = cache.lineOrigin(li, lj, dir);
                 rates.integrateCumulative(origin, dir, 0.0f, cache.h_, samplesPerLine, opaqueDepth,
                                           recorded);
                 // Keep the samples at either end of a step where the value changes
@@ -139,13 +143,14 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates, 
         runBase[bi + 1] = runBase[bi] + blocks[bi].runs.size();
         sampleBase[bi + 1] = sampleBase[bi] + blocks[bi].samples.size();
     }
+    const std::size_t lines = tileCount * kLinesPerTile;
     cache.lineRuns_.resize(lines + 1);
     cache.runs_.resize(runBase.back() + 1);
     cache.samples_ = LargeBuffer<Lanes>(sampleBase.back()); // written by the copies below
     tbb::parallel_for(std::size_t(0), blocks.size(), [&](std::size_t bi) {
         Block& block = blocks[bi];
         for (std::size_t j = 0; j < block.lineRuns.size(); ++j)
-            cache.lineRuns_[bi * kLinesPerBlock + j] = runBase[bi] + block.lineRuns[j];
+            cache.lineRuns_[bi * kLinesPerTile + j] = runBase[bi] + block.lineRuns[j];
         for (std::size_t r = 0; r < block.runs.size(); ++r)
             cache.runs_[runBase[bi] + r] = {block.runs[r].k0, sampleBase[bi] + block.runs[r].begin};
         std::uninitialized_copy(block.samples.begin(), block.samples.end(),
@@ -246,7 +251,7 @@ void LightSpaceCache::lookup(std::span<const Vec3f> points, std::span<OpticalDep
                 if (!c.inside)
                     continue;
                 c.w = ((k & 1) ? tx : 1.0f - tx) * ((k >> 1) ? ty : 1.0f - ty);
-                c.line = static_cast<std::size_t>(jj) * std::size_t(ni_) + std::size_t(ii);
+                c.line = lineIndex(ii, jj);
                 __builtin_prefetch(&lineRuns_[c.line]);
             }
         }

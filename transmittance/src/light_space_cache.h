@@ -68,6 +68,19 @@ private:
     LineRead alongLine(std::uint64_t r0, std::uint64_t r1, float s) const;
     /// The value a read gives.
     static Lanes value(const LineRead& read);
+    /// Where line (i, j) is stored: lines are kept in tiles of kTile × kTile
+    /// (row-major within a tile, tiles row-major), the last row and column
+    /// of tiles padded with lines that hold nothing. A brick of 8³ voxels is
+    /// crossed by some 8 × 8 neighbouring lines, which a tile integrates
+    /// while the brick is in cache (in rows of the whole lattice its values
+    /// were read again a row of lines later), and a query's 4 lines are
+    /// mostly in one tile.
+    std::size_t lineIndex(int i, int j) const {
+        const auto ti = static_cast<std::size_t>(i / kTile), tj = static_cast<std::size_t>(j / kTile);
+        return ((tj * tilesPerRow_ + ti) * kTile + static_cast<std::size_t>(j % kTile)) * kTile +
+               static_cast<std::size_t>(i % kTile);
+    }
+    static constexpr int kTile = 16;
 
     /// Samples k0, k0 + 1, ... of a line, stored from samples_[begin] up to
     /// the next run's begin.
@@ -83,7 +96,10 @@ private:
     float h_ = 1;     ///< spacing along lines (world)
     float sBase_ = 0; ///< world distance of lattice s = 0 from the light plane/point
     int i0_ = 0, j0_ = 0, ni_ = 0, nj_ = 0; ///< line lattice [i0, i0 + ni) × [j0, j0 + nj)
-    LargeVector<std::uint64_t> lineRuns_; ///< line l's runs are runs_[lineRuns_[l], lineRuns_[l + 1])
+    std::size_t tilesPerRow_ = 0;          ///< ⌈ni / kTile⌉
+    /// The runs of the line stored at l = lineIndex(i, j) are
+    /// runs_[lineRuns_[l], lineRuns_[l + 1]).
+    LargeVector<std::uint64_t> lineRuns_;
     LargeVector<Run> runs_;               ///< and a sentinel whose begin is samples_.size()
     LargeBuffer<Lanes> samples_; ///< on huge pages: queries read it scattered
 };
