@@ -15,11 +15,10 @@
 // Ratboy at 0.5 mm) took 1.2 s of the 1.3 s voxelization there. jemalloc with
 // thp:always advises its extents to the kernel as transparent huge pages (one
 // fault per 2 MiB; used where /sys/kernel/mm/transparent_hugepage/enabled says
-// "madvise" or "always"), and keeps what is freed for its arena's later
-// allocations for a while (dirty_decay_ms, 10 s) rather than returning it at
-// once. Threads are spread over arenas (4 per CPU): a single one (narenas:1) would let
-// the film reuse the pages of the rate volumes the worker threads freed
-// (default scene: 411 → 392 MiB peak, the time within noise), but would
+// "madvise" or "always"), and keeps what is freed for later allocations for
+// a while (dirty_decay_ms, 10 s) rather than returning it at once. Threads
+// are spread over arenas (4 per CPU); a single arena (narenas:1) lowered the
+// default scene's peak (411 → 392 MiB, the time within noise) but would
 // contend on a many-core machine, so the default stays.
 //
 // MALLOC_CONF in the environment is read after this and overrides it
