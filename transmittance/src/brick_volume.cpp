@@ -78,12 +78,26 @@ bool boxBitSet(const std::vector<std::uint64_t>& bits, const glm::ivec3& c, cons
     return (bits[bit >> 6] >> (bit & 63)) & 1u;
 }
 
-/// The boxes of the set cells of an 8³ cell mask (bit x·64 + y·8 + z) in
-/// each of its 2³ octants of 4³ cells (octant ((x/4)·2 + y/4)·2 + z/4); lo > hi
-/// in an octant with none.
-template <typename Boxes>
-Boxes octantBoxes(const std::array<std::uint64_t, 8>& mask) {
-    Boxes result;
+} // namespace
+
+const Lanes BrickVolume::kZero{};
+
+BrickVolume::BrickVolume(double voxelSize)
+    : h_(voxelSize)
+    , invH_(static_cast<float>(1.0 / voxelSize))
+    , slots_(64, -1) {}
+
+std::size_t BrickVolume::memoryBytes() const {
+    return values_.size() * sizeof(Lanes) + present_.capacity() * sizeof(SlotBits) +
+           valueBase_.capacity() * sizeof(std::size_t) +
+           cellMask_.capacity() * sizeof(cellMask_[0]) +
+           cellBoxes_.capacity() * sizeof(OctantBoxes) +
+           (occupancy_.capacity() + superOccupancy_.capacity()) * sizeof(std::uint64_t) +
+           brickCoord_.capacity() * sizeof(glm::ivec3) + slots_.capacity() * sizeof(std::int64_t);
+}
+
+BrickVolume::OctantBoxes BrickVolume::octantBoxes(const std::array<std::uint64_t, 8>& mask) {
+    OctantBoxes result;
     auto& boxes = result.box;
     boxes.fill({{8, 8, 8}, {0, 0, 0}});
     for (int x = 0; x < 8; ++x)
@@ -103,24 +117,6 @@ Boxes octantBoxes(const std::array<std::uint64_t, 8>& mask) {
             result.whole = result.whole && boxes[o].lo[a] == lo && boxes[o].hi[a] == lo + 3;
         }
     return result;
-}
-
-} // namespace
-
-const Lanes BrickVolume::kZero{};
-
-BrickVolume::BrickVolume(double voxelSize)
-    : h_(voxelSize)
-    , invH_(static_cast<float>(1.0 / voxelSize))
-    , slots_(64, -1) {}
-
-std::size_t BrickVolume::memoryBytes() const {
-    return values_.size() * sizeof(Lanes) + present_.capacity() * sizeof(SlotBits) +
-           valueBase_.capacity() * sizeof(std::size_t) +
-           cellMask_.capacity() * sizeof(cellMask_[0]) +
-           cellBoxes_.capacity() * sizeof(OctantBoxes) +
-           (occupancy_.capacity() + superOccupancy_.capacity()) * sizeof(std::uint64_t) +
-           brickCoord_.capacity() * sizeof(glm::ivec3) + slots_.capacity() * sizeof(std::int64_t);
 }
 
 bool BrickVolume::mayMeetValues(std::size_t brick, const glm::ivec3& b,
@@ -256,7 +252,7 @@ void BrickVolume::allocateValues() {
                 }
             }
             counts[brick] = next;
-            cellBoxes_[brick] = octantBoxes<OctantBoxes>(cellMask_[brick]);
+            cellBoxes_[brick] = octantBoxes(cellMask_[brick]);
         }
     });
     valueBase_.resize(brickCount_);

@@ -226,6 +226,9 @@ private:
         bool whole = false;
     };
     std::vector<OctantBoxes> cellBoxes_;
+    /// The boxes of the set cells of a cell mask (bit x·64 + y·8 + z) in each
+    /// of its octants (octant ((x/4)·2 + y/4)·2 + z/4).
+    static OctantBoxes octantBoxes(const std::array<std::uint64_t, 8>& cellMask);
     /// The packed values of every brick, once allocateValues() has run.
     LargeBuffer<Lanes> values_;
     glm::ivec3 brickMin_{0}, brickMax_{-1};
