@@ -1,4 +1,4 @@
-// hairvox render [SCENE.json] [--exr OUT.exr] [--png OUT.png] [-o OUT.exr|OUT.png]
+// hairvox render [SCENE.json ...] [--exr OUT.exr] [--png OUT.png] [-o OUT.exr|OUT.png]
 //                [--integrator dual_scattering|path] [--mode exact|grid|approx]
 //                [--shading-rate fragment|vertex] [--exr-compression rle|zips|zip|none]
 //                [--spp N]
@@ -9,6 +9,13 @@
 // (exactly those are written); two outputs never go to the same file, nor over
 // the scene or groom file. A path trace stopped by Ctrl-C writes the whole
 // passes it finished and exits with 130.
+//
+// Several scenes (the frames of a sequence) render one after another in one
+// process: every scene is read and checked, and every output checked against
+// every other output and input, before the first render; a scene that fails
+// while rendering is reported and the batch goes on; the exit code says the
+// worst that happened (1 an internal error, 2 bad input), and Ctrl-C stops
+// the batch. Each scene writes the outputs its JSON names.
 #include "../commands.h"
 
 #include <hairvox/core/error.h>
@@ -17,18 +24,23 @@
 
 #include <algorithm>
 #include <cctype>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <optional>
+#include <sys/stat.h>
+#include <vector>
 
 namespace hairvox::cli {
 
 namespace {
 
 struct RenderCommandOptions {
-    std::string scene;
+    std::vector<std::string> scenes;
     std::string output, exr, png;
     std::string mode, integrator, shadingRate, exrCompression;
     std::optional<std::uint32_t> spp;
@@ -62,7 +74,7 @@ std::string lowerExtension(const std::filesystem::path& p) {
 /// The outputs: those of the command line (--exr, --png, -o by its extension)
 /// replace the scene's. Checks that something is written, that no two outputs
 /// share a file and that no output overwrites the scene or groom file.
-void resolveOutputs(const RenderCommandOptions& opt, Scene& scene) {
+void resolveOutputs(const RenderCommandOptions& opt, const std::string& scenePath, Scene& scene) {
     struct Output {
         std::filesystem::path path;
         std::string from; ///< the flag or scene field that set it, for messages
@@ -97,7 +109,7 @@ void resolveOutputs(const RenderCommandOptions& opt, Scene& scene) {
     for (const Output* o : {&exr, &png}) {
         if (o->path.empty())
             continue;
-        if (!opt.scene.empty() && sameFile(o->path, opt.scene))
+        if (!scenePath.empty() && sameFile(o->path, scenePath))
             throw InputError(strCat(o->from, " ", o->path.string(),
                                     " is the scene file; it would be overwritten"));
         if (!scene.groom.isProcedural() && sameFile(o->path, scene.groom.file))
@@ -130,8 +142,10 @@ void resolveResolution(const RenderCommandOptions& opt, CameraParams& camera) {
                                 kMaxResolution, " pixels a side; give both --width and --height"));
 }
 
-void runRender(const RenderCommandOptions& opt) {
-    Scene scene = opt.scene.empty() ? defaultScene() : loadScene(opt.scene);
+/// The scene at `path` (empty: the embedded default scene) with the command
+/// line's choices applied, checked.
+Scene prepareScene(const RenderCommandOptions& opt, const std::string& path) {
+    Scene scene = path.empty() ? defaultScene() : loadScene(path);
     if (!opt.mode.empty())
         scene.globalTermMode = *kGlobalTermModeNames.parse(opt.mode); // CLI11 checked the choice
     if (!opt.integrator.empty())
@@ -165,9 +179,12 @@ void runRender(const RenderCommandOptions& opt) {
     resolveResolution(opt, scene.camera);
     if (opt.voxelSize)
         scene.voxelSize = *opt.voxelSize;
-    resolveOutputs(opt, scene);
+    resolveOutputs(opt, path, scene);
     scene.validate();
+    return scene;
+}
 
+PipelineOptions pipelineOptions(const RenderCommandOptions& opt) {
     PipelineOptions options;
     if (opt.maxMemoryGiB)
         options.maxMemoryBytes =
@@ -175,7 +192,12 @@ void runRender(const RenderCommandOptions& opt) {
     options.threads = opt.threads;
     options.progress = !opt.quiet && stderrIsTerminal();
     options.continuePathTrace = opt.continueRun;
-    const SceneRender render = renderScene(scene, options);
+    return options;
+}
+
+/// Renders one prepared scene and says what it wrote.
+void renderOne(const RenderCommandOptions& opt, const Scene& scene) {
+    const SceneRender render = renderScene(scene, pipelineOptions(opt));
     for (const std::string& warning : render.warnings)
         std::cerr << "hairvox: warning: " << warning << "\n";
     if (!opt.quiet)
@@ -183,10 +205,111 @@ void runRender(const RenderCommandOptions& opt) {
     for (const auto& path : render.written)
         std::cout << "wrote " << path.string() << "\n";
     if (render.pathTrace && render.pathTrace->interrupted)
-        throw Interrupted(strCat("interrupted after ", render.pathTrace->spp, " samples per pixel; ",
-                                 render.written.empty()
-                                     ? "no output was written"
-                                     : "the image holds them (add samples with --continue)"));
+        throw Interrupted(
+            strCat("interrupted after ", render.pathTrace->spp, " samples per pixel; ",
+                   render.written.empty() ? "no output was written"
+                                          : "the image holds them (add samples with --continue)"));
+}
+
+/// What identifies a file across spellings: device and inode where it
+/// exists (hard and symbolic links), else its absolute normal path.
+std::string fileKey(const std::filesystem::path& p) {
+    struct stat st {};
+    if (::stat(p.c_str(), &st) == 0)
+        return strCat("inode ", st.st_dev, ":", st.st_ino);
+    std::error_code ec;
+    return std::filesystem::weakly_canonical(std::filesystem::absolute(p, ec), ec).string();
+}
+
+/// A batch's files: no output is written twice or over another scene's
+/// scene or groom file (each scene's own were checked by resolveOutputs()).
+void checkBatchFiles(const std::vector<std::string>& paths, const std::vector<Scene>& scenes) {
+    std::map<std::string, std::string> inputs, outputs; // file key → what it is
+    for (std::size_t i = 0; i < scenes.size(); ++i) {
+        inputs.emplace(fileKey(paths[i]), strCat("the scene file ", paths[i]));
+        if (!scenes[i].groom.isProcedural())
+            inputs.emplace(fileKey(scenes[i].groom.file),
+                           strCat(paths[i], "'s groom file ", scenes[i].groom.file.string()));
+    }
+    for (std::size_t i = 0; i < scenes.size(); ++i)
+        for (const auto& [file, field] : {std::pair{&scenes[i].output.exr, "output.exr"},
+                                          std::pair{&scenes[i].output.png, "output.png"}}) {
+            if (file->empty())
+                continue;
+            const std::string what = strCat(paths[i], "'s ", field, " ", file->string());
+            const std::string key = fileKey(*file);
+            if (const auto in = inputs.find(key); in != inputs.end())
+                throw InputError(strCat(what, " is ", in->second, "; it would be overwritten"));
+            if (const auto [out, added] = outputs.emplace(key, what); !added)
+                throw InputError(strCat(what, " and ", out->second,
+                                        " are the same file; one would overwrite the other"));
+        }
+}
+
+void runRender(const RenderCommandOptions& opt) {
+    if (opt.scenes.size() <= 1) {
+        renderOne(opt, prepareScene(opt, opt.scenes.empty() ? std::string() : opt.scenes[0]));
+        return;
+    }
+    if (!opt.output.empty() || !opt.exr.empty() || !opt.png.empty())
+        throw InputError(strCat(opt.scenes.size(),
+                                " scenes: --exr, --png and -o name one file; with several "
+                                "scenes each writes the outputs its JSON names"));
+    // Every scene is read and checked before the first render: a batch left
+    // to run overnight does not stop at a typo in its last scene.
+    std::vector<Scene> scenes;
+    std::vector<std::string> bad;
+    for (const std::string& path : opt.scenes) {
+        try {
+            scenes.push_back(prepareScene(opt, path));
+        } catch (const InputError& e) {
+            bad.push_back(strCat(path, ": ", e.what()));
+        }
+    }
+    if (!bad.empty()) {
+        std::string message = strCat(bad.size(), " of ", opt.scenes.size(),
+                                     " scenes cannot be rendered; nothing was rendered:");
+        for (const std::string& b : bad)
+            message += "\n  " + b;
+        throw InputError(message);
+    }
+    checkBatchFiles(opt.scenes, scenes);
+
+    const auto start = std::chrono::steady_clock::now();
+    std::vector<std::string> failed;
+    bool internal = false;
+    for (std::size_t i = 0; i < scenes.size(); ++i) {
+        try {
+            renderOne(opt, scenes[i]);
+        } catch (const Interrupted& e) {
+            throw Interrupted(strCat(e.what(), "; scene ", i + 1, " of ", scenes.size(), " (",
+                                     opt.scenes[i], "), the rest not rendered"));
+        } catch (const std::exception& e) {
+            const bool bug = dynamic_cast<const InputError*>(&e) == nullptr;
+            internal = internal || bug;
+            std::cerr << "hairvox: " << (bug ? "internal error: " : "error: ") << opt.scenes[i]
+                      << ": " << e.what() << "\n";
+            failed.push_back(opt.scenes[i]);
+        }
+    }
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const std::size_t rendered = scenes.size() - failed.size();
+    if (!opt.quiet) {
+        char line[160];
+        std::snprintf(line, sizeof(line),
+                      "hairvox: %zu of %zu scenes rendered in %.2f s (%.2f s a scene)\n", rendered,
+                      scenes.size(), seconds, seconds / double(scenes.size()));
+        std::cout << line;
+    }
+    if (failed.empty())
+        return;
+    std::string message = strCat(failed.size(), " of ", scenes.size(), " scenes failed:");
+    for (const std::string& f : failed)
+        message += " " + f;
+    if (internal)
+        throw std::runtime_error(message);
+    throw InputError(message);
 }
 
 } // namespace
@@ -196,8 +319,9 @@ void addRenderCommand(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand(
         "render",
         "Render a scene (default: the embedded default scene) to EXR with AOVs and a PNG");
-    cmd->add_option("scene", opt->scene,
-                    "Scene JSON file (docs/scene.md); omit for the default scene");
+    cmd->add_option("scene", opt->scenes,
+                    "Scene JSON file(s) (docs/scene.md); omit for the default scene. Several "
+                    "render one after another in one process, each to the outputs it names");
     cmd->add_option("--exr", opt->exr,
                     "Output EXR (beauty and AOVs). Outputs given on the command line replace "
                     "the scene's: only they are written");
