@@ -42,7 +42,7 @@ namespace {
 struct RenderCommandOptions {
     std::vector<std::string> scenes;
     std::string output, exr, png;
-    std::string mode, integrator, shadingRate, exrCompression;
+    std::string mode, integrator, shadingRate, exrCompression, layers;
     std::optional<std::uint32_t> spp;
     std::optional<double> timeLimit;
     std::optional<std::uint64_t> seed;
@@ -166,6 +166,18 @@ Scene prepareScene(const RenderCommandOptions& opt, const std::string& path) {
     }
     if (!opt.exrCompression.empty())
         scene.output.exrCompression = *kExrCompressionNames.parse(opt.exrCompression);
+    if (opt.layers == "all") {
+        scene.output.layers.reset();
+    } else if (opt.layers == "none") {
+        scene.output.layers.emplace();
+    } else if (!opt.layers.empty()) {
+        scene.output.layers.emplace();
+        for (std::size_t begin = 0; begin <= opt.layers.size();) {
+            const std::size_t end = std::min(opt.layers.find(',', begin), opt.layers.size());
+            scene.output.layers->push_back(opt.layers.substr(begin, end - begin));
+            begin = end + 1;
+        }
+    }
     if ((opt.spp || opt.timeLimit || opt.seed || opt.continueRun) &&
         scene.integrator != Integrator::Path)
         throw InputError("--spp, --time-limit, --seed and --continue apply to the path integrator "
@@ -350,6 +362,10 @@ void addRenderCommand(CLI::App& app) {
                     "EXR compression: rle (default), zips, zip or none; overrides the scene's "
                     "(sizes and times in docs/scene.md)")
         ->check(CLI::IsMember(kExrCompressionNames.names()));
+    cmd->add_option("--layers", opt->layers,
+                    "EXR layers besides the beauty and A: all (default), none, or names "
+                    "separated by commas (e.g. Z,hair.A,key.V); overrides the scene's "
+                    "output.layers (docs/scene.md)");
     cmd->add_option("--spp", opt->spp, "Path tracing: samples per pixel [1, 1000000]");
     cmd->add_option("--time-limit", opt->timeLimit,
                     "Path tracing: stop after this many seconds (whole passes) [0, 1e7]");

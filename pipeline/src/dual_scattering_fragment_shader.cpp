@@ -35,14 +35,19 @@ DualScatteringFragmentShader::DualScatteringFragmentShader(
     , fiberType_(fiberType)
     , lights_(std::move(lights))
     , terms_(std::move(lightTerms))
-    , stats_(lights_.size()) {
-    layout_.radiance = {"direct_R", "direct_TT", "direct_TRT", "back_direct", "scatter"};
-    for (const Light& light : lights_) {
-        layout_.averages.push_back({light.name + ".V", 1});
-        layout_.averages.push_back({light.name + ".n", 1});
-        layout_.averages.push_back({light.name + ".T_s", 3});
-        layout_.averages.push_back({light.name + ".sigma_f", 3});
+    , layout_(dualScatteringLayout(lights_))
+    , stats_(lights_.size()) {}
+
+ShaderLayout dualScatteringLayout(std::span<const Light> lights) {
+    ShaderLayout layout;
+    layout.radiance = {"direct_R", "direct_TT", "direct_TRT", "back_direct", "scatter"};
+    for (const Light& light : lights) {
+        layout.averages.push_back({light.name + ".V", 1});
+        layout.averages.push_back({light.name + ".n", 1});
+        layout.averages.push_back({light.name + ".T_s", 3});
+        layout.averages.push_back({light.name + ".sigma_f", 3});
     }
+    return layout;
 }
 
 void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,

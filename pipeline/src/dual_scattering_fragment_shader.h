@@ -24,6 +24,9 @@
 
 namespace hairvox::detail {
 
+/// The layout above for these lights.
+ShaderLayout dualScatteringLayout(std::span<const Light> lights);
+
 class DualScatteringFragmentShader final : public FragmentShader {
 public:
     /// `shaders[t]` shades fiber type t; `fiberType` is the groom's

@@ -68,14 +68,20 @@ void warnAboutLights(const Scene& scene, const SceneSurfaces& surfaces,
     }
 }
 
-/// A warning when no pixel of the rendered image covers hair.
-void warnIfNoHairSeen(const Scene& scene, const Film& film, const Groom* groom,
-                      std::vector<std::string>& warnings) {
+/// Whether a pixel of the film covers hair (its hair alpha layer), or
+/// nothing is known (no such layer, no pixel).
+bool filmShowsHair(const Film& film) {
     const auto hair = film.find(kHairAlphaLayer);
     if (!hair || film.pixelCount() == 0)
-        return;
+        return true;
     const auto& a = film.layer(*hair).data;
-    if (std::any_of(a.begin(), a.end(), [](float x) { return x > 0; }))
+    return std::any_of(a.begin(), a.end(), [](float x) { return x > 0; });
+}
+
+/// A warning when no pixel of the rendered image covers hair.
+void warnIfNoHairSeen(const Scene& scene, bool hairSeen, const Groom* groom,
+                      std::vector<std::string>& warnings) {
+    if (hairSeen)
         return;
     std::string bounds;
     if (groom) {
@@ -83,9 +89,9 @@ void warnIfNoHairSeen(const Scene& scene, const Film& film, const Groom* groom,
         bounds = b.empty() ? std::string(" (the groom is empty)")
                            : strCat(" (groom bounds ", vecText(b.min), " to ", vecText(b.max), ")");
     }
-    warnings.push_back(strCat("the camera sees no hair: no pixel of the ", film.width(), "x",
-                              film.height(), " image covers a fiber", bounds, "; camera.position ",
-                              vecText(scene.camera.position), ", look_at ",
+    warnings.push_back(strCat("the camera sees no hair: no pixel of the ", scene.camera.width, "x",
+                              scene.camera.height, " image covers a fiber", bounds,
+                              "; camera.position ", vecText(scene.camera.position), ", look_at ",
                               vecText(scene.camera.lookAt), ", fov ", scene.camera.fovY));
 }
 
@@ -112,9 +118,13 @@ MemoryEstimate estimateRenderMemory(const Scene& scene) {
         if (scene.output.exr.empty() ? false : std::filesystem::exists(scene.output.exr))
             perPixel += 2 * 29 * 4; // a continued run reads the earlier EXR into a film
     } else {
-        // beauty 3, A 1, 5 radiance components × 3, surface 3, background 3,
-        // hair.A 1, depth 1; per light V 1, n 1, T_s 3, sigma_f 3.
-        m.filmChannels = 27 + 8 * static_cast<int>(scene.lights.size());
+        // beauty 3, A 1, and the layers output.layers keeps.
+        m.filmChannels = 4;
+        for (const RasterLayer& l : layersOf(scene))
+            if (!scene.output.layers ||
+                std::find(scene.output.layers->begin(), scene.output.layers->end(), l.name) !=
+                    scene.output.layers->end())
+                m.filmChannels += l.channels;
         perPixel += std::uint64_t(m.filmChannels) * 4;
         if (scene.head || !scene.meshes.empty())
             // The surface layer (coverage, depth, radiance), the corner rays'
@@ -214,6 +224,7 @@ RasterSettings rasterSettings(const Scene& scene, const PipelineOptions& options
     s.shadingTolerance = scene.shadingTolerance;
     s.tailTransmittance = scene.tailTransmittance;
     s.background = scene.background;
+    s.layers = scene.output.layers;
     s.threads = options.threads;
     s.progress = options.progress;
     return s;
@@ -398,7 +409,8 @@ SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& opti
     warnAboutLights(scene, assets->surfaces, result.warnings);
     for (std::string& w : image.warnings)
         result.warnings.push_back(std::move(w));
-    warnIfNoHairSeen(scene, result.film, &groom.groom, result.warnings);
+    // (From the stats: the hair alpha layer may not be stored.)
+    warnIfNoHairSeen(scene, image.stats.fragmentsComposited > 0, &groom.groom, result.warnings);
 
     // The renderer's shading time includes the global-term evaluations made
     // inside the shader: apportion it by the shader's own thread time.
@@ -483,7 +495,7 @@ SceneRender renderPathTraced(const Scene& scene, const PipelineOptions& options,
     result.pathTrace = traced.stats;
     warnAboutLights(scene, surfaces, result.warnings);
     if (traced.stats.spp > 0) // an image without samples says nothing about what the camera sees
-        warnIfNoHairSeen(scene, result.film, &groom, result.warnings);
+        warnIfNoHairSeen(scene, filmShowsHair(result.film), &groom, result.warnings);
     for (const Light& light : scene.lights)
         result.lights.push_back({light.name, light.isDark(), 0.0, 0, {}});
 
@@ -748,6 +760,16 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
                             " interpolated from ", thousands(st.tailVertices), " strand vertices")
                    : std::string()));
     row("write", r.times.write, written.empty() ? "nothing" : written);
+    if (scene.output.layers) {
+        int stored = 0, all = 4; // the beauty and "A" are always there
+        for (const FilmLayer& l : r.film.layers())
+            stored += l.channels;
+        for (const RasterLayer& l : layersOf(scene))
+            all += l.channels;
+        more(strCat(stored, " of ", all,
+                    " channels (output.layers): the others are neither stored "
+                    "in the film nor written"));
+    }
 }
 
 } // namespace hairvox

@@ -1,3 +1,4 @@
+#include "dual_scattering_fragment_shader.h"
 #include "json_reader.h"
 
 #include <hairvox/core/error.h>
@@ -28,6 +29,8 @@ constexpr Range kAlbedo{0.0, 1.0};
 constexpr Range kVoxelSize{0.0, 1000.0, true};
 constexpr Range kFiberSampleSpacing{0.0, 4.0};
 constexpr std::uint64_t kMaxExactRays = 65536;
+/// output.layers: more names than any scene has layers (27 + 8 per light).
+constexpr std::size_t kMaxLayers = 256;
 constexpr Range kExactRadius{0.0, 1000.0};
 constexpr Range kBackground{0.0, 1e6};
 constexpr Range kShadingTolerance{0.0, 1.0};
@@ -344,6 +347,17 @@ OutputSettings parseOutput(JsonObject obj, const std::string& stem) {
         o.exrZipLevel = static_cast<int>(v.integer(1, 9));
     if (const JsonValue v = obj["exr_compression"]; v.present())
         o.exrCompression = v.oneOf(kExrCompressionNames);
+    if (const JsonValue v = obj["layers"]; v.present()) {
+        if (!v.isString()) {
+            o.layers.emplace();
+            for (const JsonValue& name : v.array(0, kMaxLayers))
+                o.layers->push_back(name.string());
+        } else if (const std::string s = v.string(); s == "none") {
+            o.layers.emplace();
+        } else if (s != "all") {
+            v.failExpected("\"all\", \"none\" or an array of layer names");
+        }
+    }
     obj.finish();
     return o;
 }
@@ -433,6 +447,33 @@ void Scene::validate() const {
     if (!output.exr.empty() && output.exr.lexically_normal() == output.png.lexically_normal())
         throw InputError(strCat("output.exr and output.png are both \"", output.exr.string(),
                                 "\": the EXR and the PNG need different paths"));
+    if (output.layers) {
+        if (integrator == Integrator::Path)
+            throw InputError("output.layers: the path integrator writes every layer (--continue "
+                             "reads them back); give \"all\" or leave it out");
+        const std::vector<RasterLayer> known = layersOf(*this);
+        const auto& names = *output.layers;
+        for (std::size_t i = 0; i < names.size(); ++i) {
+            const std::string field = strCat("output.layers[", i, "] \"", names[i], "\"");
+            if (std::none_of(known.begin(), known.end(),
+                             [&](const RasterLayer& l) { return l.name == names[i]; })) {
+                std::string valid;
+                for (const RasterLayer& l : known)
+                    valid += (valid.empty() ? "" : ", ") + l.name;
+                throw InputError(strCat(field,
+                                        ": not a layer of this scene; expected \"all\", "
+                                        "\"none\" or some of: ",
+                                        valid));
+            }
+            if (std::find(names.begin(), names.begin() + std::ptrdiff_t(i), names[i]) !=
+                names.begin() + std::ptrdiff_t(i))
+                throw InputError(strCat(field, " is named twice"));
+        }
+    }
+}
+
+std::vector<RasterLayer> layersOf(const Scene& scene) {
+    return rasterLayers(detail::dualScatteringLayout(scene.lights));
 }
 
 Scene parseScene(const nlohmann::json& document, const std::string& sourceName,

@@ -28,6 +28,8 @@ using Clock = std::chrono::steady_clock;
 
 constexpr int kTileSize = 32;
 constexpr std::uint32_t kSurfaceFragment = std::numeric_limits<std::uint32_t>::max();
+/// A film layer RasterSettings::layers leaves out.
+constexpr std::size_t kNotStored = std::numeric_limits<std::size_t>::max();
 constexpr std::size_t kShadeBatch = 1024;
 constexpr std::size_t kMaxWarnings = 10;
 /// Segments per binning chunk: at least this many, and at most 256 chunks.
@@ -137,9 +139,15 @@ struct RenderContext {
     std::vector<std::uint32_t> binSegments;
     Film* film = nullptr;
     /// Film layer indices: the shader's radiance and average layers, then the rasterizer's own.
+    /// kNotStored where RasterSettings::layers leaves a layer out.
     std::vector<std::size_t> radianceLayer, averageLayer;
     std::size_t beautyLayer = 0, alphaLayer = 0, surfaceLayer = 0, backgroundLayer = 0,
                 hairAlphaLayer = 0, depthLayer = 0;
+
+    /// The layer's values, or null where it is not stored.
+    float* values(std::size_t layer) const {
+        return layer == kNotStored ? nullptr : film->layer(layer).data.data();
+    }
 
     RenderContext(const Groom& g, const Camera& c, const FragmentShader& sh,
                   const RasterSettings& st, const SurfaceLayer& su)
@@ -653,23 +661,28 @@ private:
     }
 
     void finishCoverage() {
-        float* alpha = film_.layer(ctx_.alphaLayer).data.data();
-        float* hairAlpha = film_.layer(ctx_.hairAlphaLayer).data.data();
-        float* depth = film_.layer(ctx_.depthLayer).data.data();
-        float* surface = film_.layer(ctx_.surfaceLayer).data.data();
-        float* background = film_.layer(ctx_.backgroundLayer).data.data();
-        float* beauty = film_.layer(ctx_.beautyLayer).data.data();
+        float* alpha = ctx_.values(ctx_.alphaLayer);
+        float* hairAlpha = ctx_.values(ctx_.hairAlphaLayer);
+        float* depth = ctx_.values(ctx_.depthLayer);
+        float* surface = ctx_.values(ctx_.surfaceLayer);
+        float* background = ctx_.values(ctx_.backgroundLayer);
+        float* beauty = ctx_.values(ctx_.beautyLayer);
         for (std::uint32_t p = 0; p < area_; ++p) {
             const PixelState& st = s_.pixels[p];
             const std::size_t i = filmIndex(p);
             alpha[i] = 1.0f - st.T;
-            hairAlpha[i] = st.hairWeight;
-            depth[i] = st.T < 1.0f ? st.depthSum / (1.0f - st.T) : 0.0f;
+            if (hairAlpha)
+                hairAlpha[i] = st.hairWeight;
+            if (depth)
+                depth[i] = st.T < 1.0f ? st.depthSum / (1.0f - st.T) : 0.0f;
             const Rgb b = st.T * ctx_.settings.background;
             for (int c = 0; c < 3; ++c) {
-                surface[3 * i + std::size_t(c)] = st.surface[c];
-                background[3 * i + std::size_t(c)] = b[c];
-                beauty[3 * i + std::size_t(c)] = st.surface[c] + b[c];
+                const std::size_t k = 3 * i + std::size_t(c);
+                if (surface)
+                    surface[k] = st.surface[c];
+                if (background)
+                    background[k] = b[c];
+                beauty[k] = st.surface[c] + b[c];
             }
         }
     }
@@ -925,26 +938,28 @@ private:
     /// Every pixel of the tile is written: the shader's layers are allocated
     /// uninitialised (Film::Init::Uninitialized).
     void finishShading() {
-        float* beauty = film_.layer(ctx_.beautyLayer).data.data();
+        float* beauty = ctx_.values(ctx_.beautyLayer);
         for (std::uint32_t p = 0; p < area_; ++p) {
             const float w = s_.pixels[p].hairWeight;
             const std::size_t i = filmIndex(p);
             // Zero where no fragment was shaded: nothing accumulated.
             const float* sum = s_.pixelSum.data() + std::size_t(p) * stride_;
             for (std::size_t l = 0; l < ctx_.radianceLayer.size(); ++l) {
-                float* layer = film_.layer(ctx_.radianceLayer[l]).data.data() + 3 * i;
+                float* layer = ctx_.values(ctx_.radianceLayer[l]);
                 for (std::size_t c = 0; c < 3; ++c) {
-                    layer[c] = sum[3 * l + c];
+                    if (layer)
+                        layer[3 * i + c] = sum[3 * l + c];
                     beauty[3 * i + c] += sum[3 * l + c];
                 }
             }
             const float invW = w > 0 ? 1.0f / w : 0.0f;
             std::size_t k = ctx_.radianceFloats;
             for (std::size_t l = 0; l < ctx_.averageLayer.size(); ++l) {
-                FilmLayer& layer = film_.layer(ctx_.averageLayer[l]);
-                const auto channels = static_cast<std::size_t>(layer.channels);
-                for (std::size_t c = 0; c < channels; ++c)
-                    layer.data[channels * i + c] = sum[k++] * invW;
+                const auto channels = static_cast<std::size_t>(ctx_.layout.averages[l].channels);
+                if (float* layer = ctx_.values(ctx_.averageLayer[l]))
+                    for (std::size_t c = 0; c < channels; ++c)
+                        layer[channels * i + c] = sum[k + c] * invW;
+                k += channels;
             }
         }
     }
@@ -980,6 +995,19 @@ std::ostream& operator<<(std::ostream& os, const RasterStats& s) {
               << " probed segments smooth, " << s.tailFragments << " behind the tail from "
               << s.tailVertices << " vertices, " << s.invalidSamples << " rejected; "
               << s.tiles << " tiles)";
+}
+
+std::vector<RasterLayer> rasterLayers(const ShaderLayout& layout) {
+    std::vector<RasterLayer> layers;
+    for (const std::string& name : layout.radiance)
+        layers.push_back({name, 3, false});
+    layers.push_back({kSurfaceLayer, 3, false});
+    layers.push_back({kBackgroundLayer, 3, false});
+    layers.push_back({kHairAlphaLayer, 1, false});
+    layers.push_back({kDepthLayer, 1, /*fullPrecision=*/true}); // half is too coarse for depth
+    for (const ShaderLayout::AverageLayer& a : layout.averages)
+        layers.push_back({a.name, a.channels, false});
+    return layers;
 }
 
 RasterOutput rasterize(const Groom& groom, const Camera& camera, const FragmentShader& shader,
@@ -1018,14 +1046,28 @@ RasterOutput rasterize(const Groom& groom, const Camera& camera, const FragmentS
     constexpr Film::Init tileWritten = Film::Init::Uninitialized;
     ctx.beautyLayer = film.addLayer(std::string(Film::kBeauty), 3, false, tileWritten);
     ctx.alphaLayer = film.addLayer(std::string(Film::kAlpha), 1, false, tileWritten);
-    for (const std::string& name : ctx.layout.radiance)
-        ctx.radianceLayer.push_back(film.addLayer(name, 3, false, tileWritten));
-    ctx.surfaceLayer = film.addLayer(kSurfaceLayer, 3, false, tileWritten);
-    ctx.backgroundLayer = film.addLayer(kBackgroundLayer, 3, false, tileWritten);
-    ctx.hairAlphaLayer = film.addLayer(kHairAlphaLayer, 1, false, tileWritten);
-    ctx.depthLayer = film.addLayer(kDepthLayer, 1, /*fullPrecision=*/true, tileWritten);
-    for (const ShaderLayout::AverageLayer& a : ctx.layout.averages)
-        ctx.averageLayer.push_back(film.addLayer(a.name, a.channels, false, tileWritten));
+    const std::vector<RasterLayer> layers = rasterLayers(ctx.layout);
+    if (settings.layers)
+        for (const std::string& name : *settings.layers)
+            if (std::none_of(layers.begin(), layers.end(),
+                             [&](const RasterLayer& l) { return l.name == name; }))
+                throw InputError(strCat("layer \"", name, "\": not a layer of this render"));
+    std::vector<std::size_t> index;
+    for (const RasterLayer& l : layers) {
+        const bool stored = !settings.layers ||
+                            std::find(settings.layers->begin(), settings.layers->end(), l.name) !=
+                                settings.layers->end();
+        index.push_back(stored ? film.addLayer(l.name, l.channels, l.fullPrecision, tileWritten)
+                               : kNotStored);
+    }
+    // rasterLayers()' order: radiance, the rasterizer's four, averages.
+    const std::size_t radiance = ctx.layout.radiance.size();
+    ctx.radianceLayer.assign(index.begin(), index.begin() + std::ptrdiff_t(radiance));
+    ctx.surfaceLayer = index[radiance];
+    ctx.backgroundLayer = index[radiance + 1];
+    ctx.hairAlphaLayer = index[radiance + 2];
+    ctx.depthLayer = index[radiance + 3];
+    ctx.averageLayer.assign(index.begin() + std::ptrdiff_t(radiance + 4), index.end());
     ctx.film = &film;
 
     prepareVertices(groom, ctx.camera, settings.fiberScale, ctx.tangents, ctx.projected);

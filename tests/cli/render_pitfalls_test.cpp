@@ -233,6 +233,32 @@ TEST(CliRenderOptions, ExrCompressionIsChosenOnTheCommandLine) {
     EXPECT_TRUE(contains(r.output, "--exr-compression")) << r.output;
 }
 
+TEST(CliRenderOptions, LayersAreChosenOnTheCommandLine) {
+    test::TempDir dir;
+    SmallScene scene;
+    scene.output = outputs(dir / "all.exr", dir / "r.png");
+    const fs::path file = scene.write(dir);
+    auto r = test::runHairvox("render " + quoted(file) + " --quiet");
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    r = test::runHairvox("render " + quoted(file) + " --exr " + quoted(dir / "none.exr") +
+                         " --layers none");
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_TRUE(contains(r.output, "4 of 35 channels (output.layers)")) << r.output;
+    const ExrImage all = readExr(dir / "all.exr"), none = readExr(dir / "none.exr");
+    ASSERT_EQ(none.channels.size(), 4u);
+    for (const char* c : {"R", "G", "B", "A"})
+        EXPECT_EQ(none.channels.at(c), all.channels.at(c)) << c << " changed";
+    r = test::runHairvox("render " + quoted(file) + " --quiet --exr " +
+                         quoted(dir / "some.exr") + " --layers Z,key.V");
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_EQ(readExr(dir / "some.exr").channels.size(), 6u);
+    r = test::runHairvox("render " + quoted(file) + " --quiet --exr " + quoted(dir / "x.exr") +
+                         " --layers Z,key.v");
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_TRUE(contains(r.output, "output.layers[1] \"key.v\": not a layer")) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "x.exr"));
+}
+
 TEST(CliRenderMemory, AbsurdSizeFailsFastWithTheEstimate) {
     test::TempDir dir;
     const auto start = std::chrono::steady_clock::now();

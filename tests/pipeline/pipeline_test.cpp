@@ -230,6 +230,48 @@ TEST(RenderPipeline, HeadIsLambertianAndHidesTheHairBehindIt) {
     EXPECT_GT(r.raster->segmentTilesBehindSurfaces, 0u);
 }
 
+// output.layers: the layers left out are neither in the film nor in the
+// EXR, the memory estimate counts only the kept ones, and the beauty and
+// the kept layers are the same floats as in a render of every layer.
+TEST(RenderPipeline, LayersLeftOutAreNotStoredAndChangeNothingElse) {
+    test::TempDir dir;
+    const Scene all = smallScene(dir);
+    Scene some = all;
+    some.output.exr = dir / "some.exr";
+    some.output.png.clear();
+    some.output.layers = std::vector<std::string>{"Z", "key.T_s"};
+    some.validate();
+    const SceneRender full = renderScene(all, options(dir), false);
+    const SceneRender kept = renderScene(some, options(dir));
+    std::vector<std::string> names;
+    for (const FilmLayer& l : kept.film.layers())
+        names.push_back(l.name);
+    EXPECT_EQ(names, (std::vector<std::string>{"", "A", "Z", "key.T_s"}));
+    for (const std::string& name : names) {
+        const FilmLayer& a = full.film.layer(name);
+        const FilmLayer& b = kept.film.layer(name);
+        ASSERT_EQ(a.data.size(), b.data.size()) << name;
+        EXPECT_EQ(std::memcmp(a.data.data(), b.data.data(), a.data.size() * sizeof(float)), 0)
+            << name << " differs";
+    }
+    const ExrImage exr = readExr(some.output.exr);
+    EXPECT_EQ(exr.channels.size(), 4u + 1u + 3u); // R G B A, Z, key.T_s.{R,G,B}
+    EXPECT_FALSE(exr.channels.count("hair.A"));
+    EXPECT_TRUE(exr.channels.count("key.T_s.G"));
+    int fullChannels = 0;
+    for (const FilmLayer& l : full.film.layers())
+        fullChannels += l.channels;
+    EXPECT_EQ(estimateRenderMemory(all).filmChannels, fullChannels);
+    EXPECT_EQ(estimateRenderMemory(some).filmChannels, 4 + 1 + 3);
+    // None: the beauty and its alpha only; no hair alpha, yet the camera
+    // still knows it sees hair (no "sees no hair" warning).
+    some.output.layers = std::vector<std::string>{};
+    const SceneRender none = renderScene(some, options(dir), false);
+    EXPECT_EQ(none.film.layers().size(), 2u);
+    for (const std::string& w : none.warnings)
+        EXPECT_EQ(w.find("sees no hair"), std::string::npos) << w;
+}
+
 TEST(RenderPipeline, SameBytesForAnyThreadCount) {
     test::TempDir dir;
     const Scene scene = smallScene(dir);

@@ -116,6 +116,37 @@ TEST(Scene, EveryFeatureParses) {
     }
 }
 
+TEST(Scene, OutputLayersNameLayersOfTheScene) {
+    nlohmann::json j = validScene();
+    EXPECT_FALSE(parseScene(j, "scene.json", "/").output.layers.has_value()); // all
+    j["lights"][0]["name"] = "key";
+    j["output"]["layers"] = {"Z", "key.V", "direct_TT", "light1.sigma_f"};
+    const Scene s = parseScene(j, "scene.json", "/");
+    ASSERT_TRUE(s.output.layers.has_value());
+    EXPECT_EQ(*s.output.layers,
+              (std::vector<std::string>{"Z", "key.V", "direct_TT", "light1.sigma_f"}));
+    j["output"]["layers"] = "none";
+    EXPECT_TRUE(parseScene(j, "scene.json", "/").output.layers->empty());
+    j["output"]["layers"] = "all";
+    EXPECT_FALSE(parseScene(j, "scene.json", "/").output.layers.has_value());
+    const auto fails = [&](const nlohmann::json& layers, const std::string& part) {
+        j["output"]["layers"] = layers;
+        const std::string e = errorOf(j);
+        EXPECT_NE(e.find(part), std::string::npos) << layers.dump() << ": " << e;
+    };
+    fails("some", "/output/layers");
+    fails(3, "/output/layers");
+    fails({"Z", 1}, "/output/layers/1");
+    fails({"key.v"}, "output.layers[0] \"key.v\": not a layer of this scene");
+    fails({"key.v"}, "some of: direct_R, direct_TT");
+    fails({"A"}, "not a layer"); // always written: not a choice
+    fails({"Z", "Z"}, "output.layers[1] \"Z\" is named twice");
+    j["output"]["layers"] = {"Z"};
+    j["integrator"] = {{"type", "path"}};
+    EXPECT_NE(errorOf(j).find("the path integrator writes every layer"), std::string::npos)
+        << errorOf(j);
+}
+
 TEST(Scene, ShadingToleranceBelongsToTheAdaptiveRate) {
     nlohmann::json j = validScene();
     j["shading_rate"] = "adaptive";

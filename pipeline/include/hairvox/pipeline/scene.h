@@ -22,6 +22,7 @@
 #include <hairvox/pathtrace/path_tracer.h>
 #include <hairvox/pipeline/groom_attributes.h>
 #include <hairvox/render/fragment_shader.h>
+#include <hairvox/render/rasterizer.h>
 #include <hairvox/shading/fiber_params.h>
 #include <hairvox/strands/fiber_scale.h>
 #include <hairvox/strands/procedural.h>
@@ -103,6 +104,11 @@ struct OutputSettings {
     ToneMap toneMap = ToneMap::Filmic; ///< of the PNG preview (film/image_file.h)
     int exrZipLevel = kDefaultExrZipLevel; ///< zlib level of the EXR, [1, 9] (ExrHeader)
     ExrCompression exrCompression = ExrCompression::Rle; ///< of the EXR (ExrCompression)
+    /// The EXR's layers besides the beauty and "A" (always written), dual
+    /// scattering only: null ("all"), every layer; else those named
+    /// (layersOf(); "none": an empty list). The others are not stored in
+    /// the film at all.
+    std::optional<std::vector<std::string>> layers;
 };
 
 struct Scene {
@@ -138,6 +144,11 @@ struct Scene {
 };
 
 std::ostream& operator<<(std::ostream& os, const Scene& scene);
+
+/// The layers a dual-scattering render of the scene can write besides the
+/// beauty and "A" (rasterLayers() for its lights), in the EXR's order:
+/// what OutputSettings::layers chooses from.
+std::vector<RasterLayer> layersOf(const Scene& scene);
 
 inline constexpr std::size_t kMaxLights = 16;
 inline constexpr std::size_t kMaxMeshes = 64;

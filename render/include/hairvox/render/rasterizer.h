@@ -40,7 +40,9 @@
 //     beauty = Σ shader radiance layers + surface + background;
 // the hair's share of the alpha (kHairAlphaLayer); the depth (kDepthLayer,
 // camera-space z averaged with the compositing weights, 0 where empty); and
-// the shader's average layers.
+// the shader's average layers. RasterSettings::layers keeps only some of
+// them besides the beauty and "A": the others are neither allocated nor
+// written, and the beauty is the same.
 #pragma once
 
 #include <hairvox/core/large_array.h>
@@ -52,6 +54,7 @@
 #include <hairvox/strands/groom.h>
 
 #include <cstdint>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -62,6 +65,18 @@ inline constexpr const char* kSurfaceLayer = "surface";
 inline constexpr const char* kBackgroundLayer = "background";
 inline constexpr const char* kHairAlphaLayer = "hair.A";
 inline constexpr const char* kDepthLayer = "Z";
+
+/// A film layer the rasterizer can store besides the beauty "" and "A".
+struct RasterLayer {
+    std::string name;
+    int channels = 3;           ///< 1 or 3
+    bool fullPrecision = false; ///< FilmLayer::fullPrecision
+};
+
+/// Every such layer for a shader's layout, in film order: the shader's
+/// radiance layers, kSurfaceLayer, kBackgroundLayer, kHairAlphaLayer,
+/// kDepthLayer, then the shader's average layers.
+std::vector<RasterLayer> rasterLayers(const ShaderLayout& layout);
 
 /// Opaque surfaces as the camera sees them, per pixel (row-major, the
 /// camera's resolution): the fraction of the pixel they cover, their mean
@@ -90,6 +105,10 @@ struct RasterSettings {
     /// transmittance interpolates strand-vertex results instead of being
     /// shaded (fragment_shader.h); at most this share of a pixel. 0: none. [0, 1]
     float tailTransmittance = kDefaultTailTransmittance;
+    /// The layers stored besides the beauty and "A" (always stored): null,
+    /// every one of rasterLayers(); else those named, in any order (an
+    /// unknown name is an InputError).
+    std::optional<std::vector<std::string>> layers;
     int threads = 0;       ///< 0: all cores
     bool progress = false; ///< draw a progress bar on stderr (the caller checks it is a terminal)
 };
