@@ -47,6 +47,12 @@ public:
 };
 
 void writeText(const std::filesystem::path& path, const std::string& text);
+/// The file's bytes ("" if it cannot be read).
+std::string readBytes(const std::filesystem::path& path);
+/// The path in single quotes, for a command line of runHairvox().
+std::string quoted(const std::filesystem::path& path);
+/// Whether `text` contains `part`.
+bool contains(const std::string& text, const std::string& part);
 
 /// The repository's data/ directory.
 std::filesystem::path dataDir();

@@ -3,22 +3,12 @@
 
 #include <gtest/gtest.h>
 
-#include <fstream>
-#include <sstream>
 
 namespace hairvox {
 namespace {
 
-std::string readText(const std::filesystem::path& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-std::string quoted(const std::filesystem::path& p) {
-    return "'" + p.string() + "'";
-}
+using test::quoted;
+using test::readBytes;
 
 TEST(CliCommands, RenderDefaultSceneSmall) {
     test::TempDir dir;
@@ -36,7 +26,7 @@ TEST(CliCommands, RenderDefaultSceneSmall) {
 
 TEST(CliCommands, RenderRejectsBadSceneAndOptions) {
     test::TempDir dir;
-    std::string scene = readText(test::dataDir() / "scenes" / "default.json");
+    std::string scene = readBytes(test::dataDir() / "scenes" / "default.json");
     const std::string direction = "\"direction\": [-0.2, 0.55, 0.8]";
     ASSERT_NE(scene.find(direction), std::string::npos);
     scene.replace(scene.find(direction), direction.size(), "\"direction\": \"up\"");
@@ -55,14 +45,14 @@ TEST(CliCommands, ProbeSampleThenEvaluateEveryMode) {
     auto r = test::runHairvox("probe " + groom + " --sample-points 40 --seed 2 -o " +
                               quoted(dir / "in.csv"));
     ASSERT_EQ(r.exitCode, 0) << r.output;
-    EXPECT_EQ(readText(dir / "in.csv").rfind("x,y,z,tx,ty,tz,strand\n", 0), 0u);
+    EXPECT_EQ(readBytes(dir / "in.csv").rfind("x,y,z,tx,ty,tz,strand\n", 0), 0u);
     for (const char* mode : {"exact", "grid", "approx"}) {
         const auto out = dir / (std::string(mode) + ".csv");
         r = test::runHairvox("probe " + groom + " --points " + quoted(dir / "in.csv") +
                              " --light-dir 0,1,0.3 --mode " + mode +
                              " --rays 8 --radius 0.003 -o " + quoted(out));
         ASSERT_EQ(r.exitCode, 0) << mode << ": " << r.output;
-        const std::string csv = readText(out);
+        const std::string csv = readBytes(out);
         EXPECT_EQ(csv.rfind("x,y,z,tx,ty,tz,n,V,P_r,P_g,P_b,Ts_r,Ts_g,Ts_b,sf2_r,sf2_g,sf2_b\n", 0),
                   0u);
         EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 41);
@@ -116,7 +106,7 @@ TEST(CliCommands, TablesFromScene) {
         "tables --scene " + quoted(test::dataDir() / "scenes" / "ratboy_mohawk.json") +
         " --cache-dir " + quoted(dir / "cache") + " -o " + quoted(dir / "t.csv"));
     ASSERT_EQ(r.exitCode, 0) << r.output;
-    EXPECT_EQ(readText(dir / "t.csv").rfind("theta,af_r,af_g,af_b,", 0), 0u);
+    EXPECT_EQ(readBytes(dir / "t.csv").rfind("theta,af_r,af_g,af_b,", 0), 0u);
     EXPECT_EQ(
         test::runHairvox("tables --scene x.json --eta 1.5 -o " + quoted(dir / "u.csv")).exitCode,
         2); // --scene excludes fiber options

@@ -7,28 +7,15 @@
 
 #include <gtest/gtest.h>
 
-#include <fstream>
-#include <sstream>
 
 namespace hairvox {
 namespace {
 
+using test::quoted;
+using test::readBytes;
+using test::contains;
+
 namespace fs = std::filesystem;
-
-std::string quoted(const fs::path& p) {
-    return "'" + p.string() + "'";
-}
-
-std::string readBytes(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-bool contains(const std::string& text, const std::string& part) {
-    return text.find(part) != std::string::npos;
-}
 
 /// A 24 × 24 frame of 150 procedural strands, seen from `cameraX`, written
 /// to the outputs it names (`groom` replaces the procedural groom).

@@ -9,24 +9,15 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
-#include <fstream>
-#include <sstream>
 
 namespace hairvox {
 namespace {
 
+using test::quoted;
+using test::readBytes;
+using test::contains;
+
 namespace fs = std::filesystem;
-
-std::string quoted(const fs::path& p) {
-    return "'" + p.string() + "'";
-}
-
-std::string readBytes(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
 
 bool isPng(const fs::path& p) {
     return readBytes(p).rfind("\x89PNG", 0) == 0;
@@ -59,10 +50,6 @@ struct SmallScene {
 
 std::string outputs(const fs::path& exr, const fs::path& png) {
     return R"({ "exr": ")" + exr.string() + R"(", "png": ")" + png.string() + R"(" })";
-}
-
-bool contains(const std::string& text, const std::string& part) {
-    return text.find(part) != std::string::npos;
 }
 
 TEST(CliRenderOutputs, ExtensionOfOChoosesTheOutput) {

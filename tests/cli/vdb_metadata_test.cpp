@@ -12,11 +12,9 @@
 namespace hairvox {
 namespace {
 
-namespace fs = std::filesystem;
+using test::quoted;
 
-std::string quoted(const fs::path& p) {
-    return "'" + p.string() + "'";
-}
+namespace fs = std::filesystem;
 
 std::map<std::string, openvdb::GridBase::Ptr> readAll(const fs::path& path) {
     openvdb::initialize();

@@ -20,19 +20,14 @@
 namespace hairvox {
 namespace {
 
+using test::readBytes;
+
 using Sample = DualScatteringTables::Sample;
 
 const std::vector<Rgb Sample::*> kAllFields{
     &Sample::aBar_f,     &Sample::aBar_b,     &Sample::alphaBar_f,
     &Sample::alphaBar_b, &Sample::beta2Bar_f, &Sample::beta2Bar_b,
     &Sample::ABar_b,     &Sample::DeltaBar_b, &Sample::sigma2Bar_b};
-
-std::string readFile(const std::filesystem::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
 
 TEST(DualScatteringTables, MatchDesignAnchors) {
     // DESIGN.md §3: σ_a = (0.2, 0.3, 0.5), θ_o-normalised M_p.
@@ -368,7 +363,7 @@ TEST(DualScatteringTablesCache, CorruptOrTruncatedFilesAreRebuilt) {
     const DualScatteringTables good =
         DualScatteringTables::loadOrBuild(FiberParams{}, dir.path(), o);
     const auto file = DualScatteringTables::cacheFile(dir.path(), FiberParams{}, o);
-    const std::string bytes = readFile(file);
+    const std::string bytes = readBytes(file);
 
     std::string corrupt = bytes;
     corrupt[bytes.size() / 2] = static_cast<char>(corrupt[bytes.size() / 2] ^ 0x10);
@@ -379,7 +374,7 @@ TEST(DualScatteringTablesCache, CorruptOrTruncatedFilesAreRebuilt) {
             DualScatteringTables::loadOrBuild(FiberParams{}, dir.path(), o);
         EXPECT_FALSE(t.loadedFromCache());
         EXPECT_EQ(t.sample(9).aBar_f, good.sample(9).aBar_f);
-        EXPECT_EQ(readFile(file), bytes); // rewritten whole
+        EXPECT_EQ(readBytes(file), bytes); // rewritten whole
         EXPECT_TRUE(
             DualScatteringTables::loadOrBuild(FiberParams{}, dir.path(), o).loadedFromCache());
     }

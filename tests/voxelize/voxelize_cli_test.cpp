@@ -9,6 +9,8 @@
 namespace hairvox {
 namespace {
 
+using test::quoted;
+
 /// A small wavy groom written as .hair; returns its path.
 std::filesystem::path writeGroom(const test::TempDir& dir) {
     ProceduralGroomParams p;
@@ -16,10 +18,6 @@ std::filesystem::path writeGroom(const test::TempDir& dir) {
     const auto path = dir / "wavy.hair";
     writeHairFile(path, generateGroom(p));
     return path;
-}
-
-std::string quoted(const std::filesystem::path& p) {
-    return "'" + p.string() + "'";
 }
 
 TEST(VoxelizeCli, WritesAGridAndReportsIt) {
