@@ -365,7 +365,10 @@ void addRenderCommand(CLI::App& app) {
     cmd->add_option("--layers", opt->layers,
                     "EXR layers besides the beauty and A: all (default), none, or names "
                     "separated by commas (e.g. Z,hair.A,key.V); overrides the scene's "
-                    "output.layers (docs/scene.md)");
+                    "output.layers (docs/scene.md)")
+        ->check([](const std::string& list) {
+            return list.empty() ? std::string("expected all, none or layer names") : std::string();
+        });
     cmd->add_option("--spp", opt->spp, "Path tracing: samples per pixel [1, 1000000]");
     cmd->add_option("--time-limit", opt->timeLimit,
                     "Path tracing: stop after this many seconds (whole passes) [0, 1e7]");
