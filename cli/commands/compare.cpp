@@ -99,7 +99,10 @@ void runCompare(const CompareOptions& opt) {
             }
             return ComparedImage::beautyOf(film, opt.mask);
         } catch (const std::out_of_range& e) {
-            throw InputError(strCat(path, ": ", e.what()));
+            throw InputError(strCat(path, ": ", e.what(),
+                                    " (a render with output.layers keeps only some layers: "
+                                    "compare what both have with --what beauty --mask A, or "
+                                    "--layers)"));
         }
     };
     const ComparedImage estimate = load(opt.estimate).boxFiltered(opt.block),

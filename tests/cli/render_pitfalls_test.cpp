@@ -235,6 +235,15 @@ TEST(CliRenderOptions, LayersAreChosenOnTheCommandLine) {
     ASSERT_EQ(none.channels.size(), 4u);
     for (const char* c : {"R", "G", "B", "A"})
         EXPECT_EQ(none.channels.at(c), all.channels.at(c)) << c << " changed";
+    // compare: without the hair alpha, the mask it reads by default is named
+    // with what to do; the beauty under A compares.
+    r = test::runHairvox("compare " + quoted(dir / "none.exr") + " " + quoted(dir / "all.exr"));
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_TRUE(contains(r.output, "--what beauty --mask A")) << r.output;
+    r = test::runHairvox("compare " + quoted(dir / "none.exr") + " " + quoted(dir / "all.exr") +
+                         " --what beauty --mask A");
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_TRUE(contains(r.output, "relative L1:     0.0000")) << r.output;
     r = test::runHairvox("render " + quoted(file) + " --quiet --exr " +
                          quoted(dir / "some.exr") + " --layers Z,key.V");
     ASSERT_EQ(r.exitCode, 0) << r.output;
