@@ -120,10 +120,9 @@ MemoryEstimate estimateRenderMemory(const Scene& scene) {
     } else {
         // beauty 3, A 1, and the layers output.layers keeps.
         m.filmChannels = 4;
+        const RasterSettings raster = rasterSettings(scene);
         for (const RasterLayer& l : layersOf(scene))
-            if (!scene.output.layers ||
-                std::find(scene.output.layers->begin(), scene.output.layers->end(), l.name) !=
-                    scene.output.layers->end())
+            if (raster.stores(l.name))
                 m.filmChannels += l.channels;
         perPixel += std::uint64_t(m.filmChannels) * 4;
         if (scene.head || !scene.meshes.empty())

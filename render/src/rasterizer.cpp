@@ -997,6 +997,10 @@ std::ostream& operator<<(std::ostream& os, const RasterStats& s) {
               << s.tiles << " tiles)";
 }
 
+bool RasterSettings::stores(const std::string& layer) const {
+    return !layers || std::find(layers->begin(), layers->end(), layer) != layers->end();
+}
+
 std::vector<RasterLayer> rasterLayers(const ShaderLayout& layout) {
     std::vector<RasterLayer> layers;
     for (const std::string& name : layout.radiance)
@@ -1053,13 +1057,10 @@ RasterOutput rasterize(const Groom& groom, const Camera& camera, const FragmentS
                              [&](const RasterLayer& l) { return l.name == name; }))
                 throw InputError(strCat("layer \"", name, "\": not a layer of this render"));
     std::vector<std::size_t> index;
-    for (const RasterLayer& l : layers) {
-        const bool stored = !settings.layers ||
-                            std::find(settings.layers->begin(), settings.layers->end(), l.name) !=
-                                settings.layers->end();
-        index.push_back(stored ? film.addLayer(l.name, l.channels, l.fullPrecision, tileWritten)
-                               : kNotStored);
-    }
+    for (const RasterLayer& l : layers)
+        index.push_back(settings.stores(l.name)
+                            ? film.addLayer(l.name, l.channels, l.fullPrecision, tileWritten)
+                            : kNotStored);
     // rasterLayers()' order: radiance, the rasterizer's four, averages.
     const std::size_t radiance = ctx.layout.radiance.size();
     ctx.radianceLayer.assign(index.begin(), index.begin() + std::ptrdiff_t(radiance));

@@ -111,6 +111,9 @@ struct RasterSettings {
     std::optional<std::vector<std::string>> layers;
     int threads = 0;       ///< 0: all cores
     bool progress = false; ///< draw a progress bar on stderr (the caller checks it is a terminal)
+
+    /// Whether `layers` keeps the named layer (every one when null).
+    bool stores(const std::string& layer) const;
 };
 
 struct RasterStats {
