@@ -15,7 +15,9 @@
 // every other output and input, before the first render; a scene that fails
 // while rendering is reported and the batch goes on; the exit code says the
 // worst that happened (1 an internal error, 2 bad input), and Ctrl-C stops
-// the batch. Each scene writes the outputs its JSON names.
+// the batch. Each scene writes the outputs its JSON names. A frame takes the
+// fiber grid and the lights' preparation from the frame before where what
+// they are made of is unchanged (FrameReuse, pipeline/pipeline.h).
 #include "../commands.h"
 
 #include <hairvox/core/error.h>
@@ -208,8 +210,8 @@ PipelineOptions pipelineOptions(const RenderCommandOptions& opt) {
 }
 
 /// Renders one prepared scene and says what it wrote.
-void renderOne(const RenderCommandOptions& opt, const Scene& scene) {
-    const SceneRender render = renderScene(scene, pipelineOptions(opt));
+void renderOne(const RenderCommandOptions& opt, const Scene& scene, FrameReuse* reuse = nullptr) {
+    const SceneRender render = renderScene(scene, pipelineOptions(opt), true, reuse);
     for (const std::string& warning : render.warnings)
         std::cerr << "hairvox: warning: " << warning << "\n";
     if (!opt.quiet)
@@ -290,9 +292,10 @@ void runRender(const RenderCommandOptions& opt) {
     const auto start = std::chrono::steady_clock::now();
     std::vector<std::string> failed;
     bool internal = false;
+    FrameReuse reuse; // the grid and lights' caches that frames share
     for (std::size_t i = 0; i < scenes.size(); ++i) {
         try {
-            renderOne(opt, scenes[i]);
+            renderOne(opt, scenes[i], &reuse);
         } catch (const Interrupted& e) {
             throw Interrupted(strCat(e.what(), "; scene ", i + 1, " of ", scenes.size(), " (",
                                      opt.scenes[i], "), the rest not rendered"));
@@ -333,7 +336,8 @@ void addRenderCommand(CLI::App& app) {
         "Render a scene (default: the embedded default scene) to EXR with AOVs and a PNG");
     cmd->add_option("scene", opt->scenes,
                     "Scene JSON file(s) (docs/scene.md); omit for the default scene. Several "
-                    "render one after another in one process, each to the outputs it names");
+                    "render one after another in one process, each to the outputs it names, "
+                    "sharing the fiber grid and the lights' preparation where unchanged");
     cmd->add_option("--exr", opt->exr,
                     "Output EXR (beauty and AOVs). Outputs given on the command line replace "
                     "the scene's: only they are written");

@@ -30,7 +30,7 @@ void put(float* out, const Rgb& c) {
 
 DualScatteringFragmentShader::DualScatteringFragmentShader(
     std::vector<DualScatteringShader> shaders, std::span<const std::uint8_t> fiberType,
-    std::vector<Light> lights, std::vector<std::unique_ptr<LightGlobalTerm>> lightTerms)
+    std::vector<Light> lights, std::vector<std::shared_ptr<const LightGlobalTerm>> lightTerms)
     : shaders_(std::move(shaders))
     , fiberType_(fiberType)
     , lights_(std::move(lights))

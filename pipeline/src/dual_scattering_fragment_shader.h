@@ -35,7 +35,7 @@ public:
     /// for a light that is skipped (contributes nothing; its AOVs read "blocked").
     DualScatteringFragmentShader(std::vector<DualScatteringShader> shaders,
                                  std::span<const std::uint8_t> fiberType, std::vector<Light> lights,
-                                 std::vector<std::unique_ptr<LightGlobalTerm>> lightTerms);
+                                 std::vector<std::shared_ptr<const LightGlobalTerm>> lightTerms);
 
     const ShaderLayout& layout() const override { return layout_; }
     void shade(std::span<const ShadingPoint> points, std::span<float> out) const override;
@@ -50,7 +50,7 @@ private:
     std::vector<DualScatteringShader> shaders_; ///< per fiber type
     std::span<const std::uint8_t> fiberType_;
     std::vector<Light> lights_;
-    std::vector<std::unique_ptr<LightGlobalTerm>> terms_;
+    std::vector<std::shared_ptr<const LightGlobalTerm>> terms_;
     ShaderLayout layout_;
     mutable std::atomic<std::int64_t> globalTermNanos_{0}, shadeNanos_{0};
     mutable std::mutex statsMutex_;

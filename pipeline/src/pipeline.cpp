@@ -20,6 +20,7 @@
 #include <cstdlib>
 #include <exception>
 #include <iomanip>
+#include <map>
 #include <sstream>
 #include <unistd.h>
 
@@ -263,32 +264,152 @@ SceneGroom loadGroom(const Scene& scene) {
     return g;
 }
 
-std::unique_ptr<SceneAssets> loadSceneAssets(const Scene& scene, const PipelineOptions& options) {
-    auto assets = std::make_unique<SceneAssets>();
+struct FrameReuse::State {
+    /// The last frame's assets (its grid, model and groom), and the keys
+    /// they were built under; null before the first frame.
+    std::shared_ptr<const SceneAssets> assets;
+    std::uint64_t gridKey = 0, modelKey = 0;
+    /// Its lights' prepared terms (of assets->globalTerm), by lightKey().
+    std::map<std::uint64_t, std::shared_ptr<const LightGlobalTerm>> lights;
+};
+
+FrameReuse::FrameReuse()
+    : state_(std::make_unique<State>()) {}
+FrameReuse::~FrameReuse() = default;
+
+namespace {
+
+SplatOptions splatOptions(const Scene& scene, const PipelineOptions& options) {
+    SplatOptions splat;
+    splat.voxelSize = scene.voxelSize.value_or(0.0f);
+    splat.fiberScale = scene.fiberScale;
+    splat.storeOrientationTensor = options.grid.orientation == OrientationModel::Tensor;
+    splat.sourceFile =
+        scene.groom.isProcedural() ? std::string("procedural") : scene.groom.file.string();
+    splat.showProgress = options.progress;
+    if (options.maxMemoryBytes > 0) {
+        const std::uint64_t used = estimateRenderMemory(scene).total();
+        splat.memoryBudgetBytes = std::min(
+            splat.memoryBudgetBytes, options.maxMemoryBytes > used ? options.maxMemoryBytes - used : 1);
+    }
+    return splat;
+}
+
+/// The groom as every stage reads it: its points, diameters and fiber types.
+std::uint64_t groomKey(const Groom& groom) {
+    Hasher h;
+    h.value(contentHash(groom));
+    h.values(std::span<const float>(groom.thickness));
+    h.values(std::span<const std::uint8_t>(groom.fiberType));
+    return h.digest();
+}
+
+/// What splatStrands() makes the fiber grid from: the groom, and the options
+/// that change the grid (not the memory budget, threads or progress).
+std::uint64_t gridKey(std::uint64_t groom, const SplatOptions& splat) {
+    Hasher h;
+    h.value(groom);
+    h.value(splat.voxelSize).value(splat.storeOrientationTensor);
+    splat.fiberScale.hashInto(h);
+    h.string(splat.sourceFile); // recorded in the grid's metadata
+    return h.digest();
+}
+
+/// What the rest of a frame's assets are made from besides the groom and
+/// the grid (0 in exact mode): the tables and crossing tables (each fiber
+/// type's optics, d_b), the model's settings (fiber scale, d_f, the
+/// surfaces' contents and colours), the global-term mode with its options,
+/// and the names the groom's and meshes' messages quote.
+std::uint64_t modelKey(std::uint64_t groomContent, std::uint64_t grid, const Scene& scene,
+                       const PipelineOptions& options, const SceneGroom& groom,
+                       const SceneSurfaces& surfaces) {
+    Hasher h;
+    h.value(groomContent).value(grid);
+    for (const FiberParams& fiber : groom.palette.fibers)
+        fiber.hashInto(h);
+    h.value(scene.dualScattering.d_f).value(scene.dualScattering.d_b);
+    scene.fiberScale.hashInto(h);
+    h.value(scene.globalTermMode);
+    h.value(scene.exact.rays).value(scene.exact.radius).value(scene.exact.seed);
+    const GridOptions& g = options.grid;
+    h.value(g.orientation).value(g.estimator).value(g.evaluation);
+    h.value(g.startOffset).value(g.cacheSpacing).value(g.fiberSampleSpacing);
+    h.value(scene.fiberSampleSpacing.has_value()).value(scene.fiberSampleSpacing.value_or(0.0f));
+    h.string(scene.groom.file.string());
+    if (surfaces.scene) {
+        for (const Sphere& sphere : surfaces.scene->spheres())
+            h.value(sphere.center).value(sphere.radius);
+        for (const TriangleMesh& mesh : surfaces.scene->meshes())
+            h.value(mesh.contentHash());
+    }
+    for (const Rgb& albedo : surfaces.albedo)
+        h.value(albedo);
+    for (const MeshSource& mesh : scene.meshes)
+        h.string(mesh.file.string());
+    return h.digest();
+}
+
+/// A light's prepared term under a model: everything of the light but its name.
+std::uint64_t lightKey(std::uint64_t model, const Light& light) {
+    Hasher h;
+    h.value(model).value(light.kind).value(light.direction).value(light.position);
+    h.value(light.color).value(light.intensity);
+    return h.digest();
+}
+
+/// What prepareAssets() did: built the assets, or found them all in the
+/// frame before (then `reused` says which), and the keys it built them under.
+struct FrameAssets {
+    const SceneAssets* reused = nullptr;
+    bool gridReused = false;
+    std::uint64_t gridKey = 0, modelKey = 0; ///< when reuse was asked for
+    double loadSeconds = 0;
+};
+
+/// loadSceneAssets() into `assets` (empty, where they will stay: the model
+/// refers to their grid and groom), taking from `reuse` (when given) the
+/// grid, or every asset of the frame before, where their keys match, and
+/// dropping the rest of the frame before before allocating anew.
+FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, SceneAssets* assets,
+                          FrameReuse::State* reuse) {
+    FrameAssets out;
     auto start = Clock::now();
     assets->groom = loadGroom(scene);
     assets->surfaces = loadSurfaces(scene);
     assets->times.load = secondsSince(start);
     throwIfInterrupted();
 
+    const std::uint64_t groom = reuse ? groomKey(assets->groom.groom) : 0;
     if (scene.globalTermMode != GlobalTermMode::Exact) {
         checkVoxelSizeForGroom(scene, assets->groom.groom);
-        start = Clock::now();
-        SplatOptions splat;
-        splat.voxelSize = scene.voxelSize.value_or(0.0f);
-        splat.fiberScale = scene.fiberScale;
-        splat.storeOrientationTensor = options.grid.orientation == OrientationModel::Tensor;
-        splat.sourceFile =
-            scene.groom.isProcedural() ? std::string("procedural") : scene.groom.file.string();
-        splat.showProgress = options.progress;
-        if (options.maxMemoryBytes > 0) {
-            const std::uint64_t used = estimateRenderMemory(scene).total();
-            splat.memoryBudgetBytes =
-                std::min(splat.memoryBudgetBytes,
-                         options.maxMemoryBytes > used ? options.maxMemoryBytes - used : 1);
+        const SplatOptions splat = splatOptions(scene, options);
+        if (reuse)
+            out.gridKey = gridKey(groom, splat);
+        if (reuse && reuse->assets && reuse->assets->grid && reuse->gridKey == out.gridKey) {
+            out.gridReused = true;
+        } else {
+            if (reuse) {
+                reuse->lights.clear();
+                reuse->assets.reset();
+            }
+            start = Clock::now();
+            assets->grid = splatStrands(assets->groom.groom, splat);
+            assets->times.voxelize = secondsSince(start);
         }
-        assets->grid = splatStrands(assets->groom.groom, splat);
-        assets->times.voxelize = secondsSince(start);
+    }
+    if (reuse) {
+        out.modelKey =
+            modelKey(groom, out.gridKey, scene, options, assets->groom, assets->surfaces);
+        if (reuse->assets && reuse->modelKey == out.modelKey) {
+            // The same groom, surfaces, grid and model: the frame before's.
+            out.loadSeconds = assets->times.load;
+            out.reused = reuse->assets.get();
+            return out;
+        }
+        if (out.gridReused) // the VDB grids are shared, not copied
+            assets->grid = reuse->assets->grid;
+        reuse->lights.clear();
+        reuse->assets.reset();
     }
 
     start = Clock::now();
@@ -306,9 +427,9 @@ std::unique_ptr<SceneAssets> loadSceneAssets(const Scene& scene, const PipelineO
     start = Clock::now();
     GlobalTermSettings settings = globalTermSettings(scene, assets->surfaces);
     settings.groom = &assets->groom.groom;
-    GridOptions grid = options.grid;
+    GridOptions gridOptions = options.grid;
     if (scene.fiberSampleSpacing)
-        grid.fiberSampleSpacing = *scene.fiberSampleSpacing;
+        gridOptions.fiberSampleSpacing = *scene.fiberSampleSpacing;
     switch (scene.globalTermMode) {
     case GlobalTermMode::Exact: {
         ExactOptions exact;
@@ -321,24 +442,46 @@ std::unique_ptr<SceneAssets> loadSceneAssets(const Scene& scene, const PipelineO
     }
     case GlobalTermMode::Grid:
         assets->globalTerm =
-            makeGridModel(*assets->grid, std::move(crossings), settings, grid);
+            makeGridModel(*assets->grid, std::move(crossings), settings, gridOptions);
         break;
     case GlobalTermMode::Approx:
         assets->globalTerm =
-            makeApproxModel(*assets->grid, std::move(crossings), settings, grid);
+            makeApproxModel(*assets->grid, std::move(crossings), settings, gridOptions);
         break;
     }
     assets->times.globalTerm = secondsSince(start);
+    out.loadSeconds = assets->times.load;
+    return out;
+}
+
+} // namespace
+
+std::unique_ptr<SceneAssets> loadSceneAssets(const Scene& scene, const PipelineOptions& options) {
+    auto assets = std::make_unique<SceneAssets>();
+    prepareAssets(scene, options, assets.get(), nullptr);
     return assets;
 }
 
 namespace {
 
 SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& options,
-                                 bool writeFiles) {
+                                 bool writeFiles, FrameReuse::State* reuse) {
     SceneRender result;
-    const std::unique_ptr<SceneAssets> assets = loadSceneAssets(scene, options);
-    result.times = assets->times;
+    auto built = std::make_shared<SceneAssets>();
+    const FrameAssets frame = prepareAssets(scene, options, built.get(), reuse);
+    const SceneAssets* assets = frame.reused ? frame.reused : built.get();
+    if (frame.reused) {
+        built.reset(); // this frame's groom and surfaces, loaded for their keys
+        result.times.load = frame.loadSeconds;
+    } else {
+        result.times = built->times;
+        if (reuse) { // for the next frame (the frame before's is gone)
+            reuse->assets = built;
+            reuse->gridKey = frame.gridKey;
+            reuse->modelKey = frame.modelKey;
+        }
+    }
+    result.gridReused = frame.gridReused;
     if (assets->surfaces.scene)
         result.surfaceTriangles = assets->surfaces.scene->triangleCount();
     if (assets->grid) {
@@ -350,8 +493,18 @@ SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& opti
     // cache). The lights are prepared concurrently: each preparation is
     // parallel, but has serial steps (the brick layout, the cache's frame)
     // that another light's work fills.
+    // With reuse, a light prepared for the frame before under the same model
+    // is taken as it is.
     const std::size_t lightCount = scene.lights.size();
-    std::vector<std::unique_ptr<LightGlobalTerm>> terms(lightCount);
+    std::vector<std::shared_ptr<const LightGlobalTerm>> terms(lightCount);
+    std::vector<std::uint64_t> lightKeys(lightCount);
+    if (reuse) { // the frame before's lights this frame does not have are freed first
+        for (std::size_t l = 0; l < lightCount; ++l)
+            lightKeys[l] = lightKey(frame.modelKey, scene.lights[l]);
+        std::erase_if(reuse->lights, [&](const auto& entry) {
+            return std::find(lightKeys.begin(), lightKeys.end(), entry.first) == lightKeys.end();
+        });
+    }
     result.lights.resize(lightCount);
     const auto prepareStart = Clock::now();
     tbb::parallel_for(std::size_t(0), lightCount, [&](std::size_t l) {
@@ -362,7 +515,14 @@ SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& opti
         if (light.isDark()) {
             report.skipped = true;
         } else {
-            terms[l] = assets->globalTerm->forLight(light);
+            if (reuse) {
+                if (const auto it = reuse->lights.find(lightKeys[l]); it != reuse->lights.end()) {
+                    terms[l] = it->second;
+                    report.reused = true;
+                }
+            }
+            if (!terms[l])
+                terms[l] = assets->globalTerm->forLight(light);
             if (terms[l]->blocksEverything()) {
                 report.skipped = true;
                 terms[l].reset();
@@ -374,6 +534,12 @@ SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& opti
     });
     result.globalTermPrepareSeconds = secondsSince(prepareStart);
     result.times.globalTerm += result.globalTermPrepareSeconds;
+    if (reuse) { // this frame's lights, for the next (the others' caches are freed)
+        reuse->lights.clear();
+        for (std::size_t l = 0; l < lightCount; ++l)
+            if (terms[l])
+                reuse->lights.emplace(lightKeys[l], terms[l]);
+    }
 
     // The surfaces as the camera sees them, lit through the hair.
     const Camera camera(scene.camera);
@@ -496,7 +662,7 @@ SceneRender renderPathTraced(const Scene& scene, const PipelineOptions& options,
     if (traced.stats.spp > 0) // an image without samples says nothing about what the camera sees
         warnIfNoHairSeen(scene, filmShowsHair(result.film), &groom, result.warnings);
     for (const Light& light : scene.lights)
-        result.lights.push_back({light.name, light.isDark(), 0.0, 0, {}});
+        result.lights.push_back({.name = light.name, .skipped = light.isDark(), .stats = {}});
 
     if (writeFiles && traced.stats.spp > previousSpp) {
         start = Clock::now();
@@ -511,7 +677,8 @@ SceneRender renderPathTraced(const Scene& scene, const PipelineOptions& options,
 
 } // namespace
 
-SceneRender renderScene(const Scene& scene, const PipelineOptions& options, bool writeFiles) {
+SceneRender renderScene(const Scene& scene, const PipelineOptions& options, bool writeFiles,
+                        FrameReuse* reuse) {
     scene.validate();
     const std::uint64_t limit =
         options.maxMemoryBytes > 0 ? options.maxMemoryBytes : defaultMemoryLimit();
@@ -532,7 +699,8 @@ SceneRender renderScene(const Scene& scene, const PipelineOptions& options, bool
     const ThreadLimit threadLimit(options.threads);
     return scene.integrator == Integrator::Path
                ? renderPathTraced(scene, withLimit, writeFiles)
-               : renderDualScattering(scene, withLimit, writeFiles);
+               : renderDualScattering(scene, withLimit, writeFiles,
+                                      reuse ? reuse->state_.get() : nullptr);
 }
 
 std::vector<std::string> hairRadianceLayers(const Film& film) {
@@ -696,8 +864,10 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
     for (const std::string& note : r.groomNotes)
         more(note);
     if (r.voxelSize > 0) {
-        std::snprintf(line, sizeof(line), "%s active voxels of %.3g",
-                      thousands(r.activeVoxels).c_str(), r.voxelSize);
+        std::snprintf(line, sizeof(line), "%s active voxels of %.3g%s",
+                      thousands(r.activeVoxels).c_str(), r.voxelSize,
+                      r.gridReused ? ": the frame before's grid (the same groom and voxel size)"
+                                   : "");
         row("voxelize", r.times.voxelize, line);
     } else {
         row("voxelize", r.times.voxelize, "not needed (exact mode)");
@@ -727,7 +897,10 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
     std::string prepared;
     for (const LightReport& l : r.lights)
         if (!l.skipped) {
-            std::snprintf(line, sizeof(line), "%s %.3f s", l.name.c_str(), l.prepareSeconds);
+            if (l.reused)
+                std::snprintf(line, sizeof(line), "%s the frame before's", l.name.c_str());
+            else
+                std::snprintf(line, sizeof(line), "%s %.3f s", l.name.c_str(), l.prepareSeconds);
             prepared += (prepared.empty() ? "" : ", ") + std::string(line);
         }
     if (!prepared.empty() && scene.globalTermMode != GlobalTermMode::Exact) {

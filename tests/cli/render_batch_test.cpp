@@ -1,5 +1,6 @@
 // `hairvox render A.json B.json ...`: the frames of a sequence rendered one
-// after another in one process. Each scene writes the bytes it writes alone;
+// after another in one process, sharing what does not change between them
+// (tests/pipeline/frame_reuse_test.cpp). Each scene writes the bytes it writes alone;
 // every scene and every output is checked before the first render; a scene
 // that fails while rendering does not stop the others, and the exit code
 // says it failed.
@@ -43,6 +44,9 @@ TEST(CliRenderBatch, EachSceneWritesWhatItWritesAlone) {
     const auto batch = test::runHairvox("render " + quoted(a) + " " + quoted(b));
     ASSERT_EQ(batch.exitCode, 0) << batch.output;
     EXPECT_TRUE(contains(batch.output, "2 of 2 scenes rendered")) << batch.output;
+    // Only the camera moved: the second frame takes the first's grid and light.
+    EXPECT_TRUE(contains(batch.output, "the frame before's grid")) << batch.output;
+    EXPECT_TRUE(contains(batch.output, "key the frame before's")) << batch.output;
     for (const char* frame : {"a", "b"}) {
         const fs::path alone = dir / (std::string(frame) + "_alone.exr");
         const auto r = test::runHairvox("render " + quoted(dir / (std::string(frame) + ".json")) +

@@ -137,6 +137,7 @@ RasterSettings rasterSettings(const Scene& scene, const PipelineOptions& options
 struct LightReport {
     std::string name;
     bool skipped = false;      ///< no irradiance, or nothing it can reach: never evaluated
+    bool reused = false;       ///< prepared for the frame before (FrameReuse)
     double prepareSeconds = 0; ///< per-light preparation (the grid mode's cache)
     /// What the preparation holds for the render (LightGlobalTerm::memoryBytes).
     std::size_t heldBytes = 0;
@@ -155,18 +156,49 @@ struct SceneRender {
     double globalTermPrepareSeconds = 0;
     std::vector<std::filesystem::path> written;
     std::uint64_t activeVoxels = 0; ///< of the fiber grid (0 in exact mode)
+    bool gridReused = false; ///< the fiber grid splatted for the frame before (FrameReuse)
     std::uint64_t surfaceTriangles = 0; ///< of the scene's meshes
     double voxelSize = 0;
     std::size_t fiberTypes = 1;         ///< of the groom (SceneGroom::palette)
     std::vector<std::string> groomNotes; ///< SceneGroom::notes, for the report
 };
 
+/// What the renders of a sequence in one process carry from one frame to the
+/// next (`hairvox render a.json b.json ...`): the fiber grid, and each light's
+/// prepared global term (the grid modes' cache), wherever everything they are
+/// computed from is what it was for the frame before. The keys are contents,
+/// not names: the groom's points, diameters and fiber types as loaded, the
+/// surfaces' triangles, and every setting the splat and the lights'
+/// preparation read (gridKey(), modelKey() in pipeline.cpp). So a camera
+/// moving around a still groom under still lights (a turntable) splats and
+/// prepares once; a frame that moves one light prepares that light again; a
+/// new colour keeps the grid and prepares the lights; a groom file rewritten
+/// between frames is splatted again. Each frame is still loaded (its contents
+/// are the key), and reused or not it is the same bytes as rendered alone.
+/// Between frames it holds one frame's groom, grid and light terms. Only the
+/// dual-scattering integrator uses it.
+class FrameReuse {
+public:
+    FrameReuse();
+    ~FrameReuse();
+    FrameReuse(const FrameReuse&) = delete;
+    FrameReuse& operator=(const FrameReuse&) = delete;
+
+    struct State; ///< (pipeline.cpp)
+
+private:
+    friend SceneRender renderScene(const Scene&, const PipelineOptions&, bool, FrameReuse*);
+    std::unique_ptr<State> state_;
+};
+
 /// Renders the scene end to end and writes its outputs (unless writeFiles is
-/// false). Refuses (InputError, before allocating) a render whose
+/// false). With `reuse`, takes what the frame before left there that this
+/// frame would compute the same, and leaves this frame's for the next. Refuses (InputError, before allocating) a render whose
 /// estimateRenderMemory() exceeds the options' limit. Warns (SceneRender::warnings)
 /// about a light that lights nothing (inside the head, or dark) by name and
 /// about an image in which no pixel covers hair.
-SceneRender renderScene(const Scene& scene, const PipelineOptions& options, bool writeFiles = true);
+SceneRender renderScene(const Scene& scene, const PipelineOptions& options, bool writeFiles = true,
+                        FrameReuse* reuse = nullptr);
 
 /// Writes the outputs the scene asks for (scene.output.exr and .png, each if
 /// non-empty) and returns their paths. EXR attributes record the scene's name
