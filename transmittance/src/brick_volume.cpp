@@ -119,11 +119,15 @@ BrickVolume::OctantBoxes BrickVolume::octantBoxes(const std::array<std::uint64_t
     return result;
 }
 
-bool BrickVolume::mayMeetValues(std::size_t brick, const glm::ivec3& b,
-                                const GridLine<float>& line, float s0, float s1) const {
+bool BrickVolume::valueSpan(std::size_t brick, const glm::ivec3& b, const GridLine<float>& line,
+                            float s0, float s1, float& spanBegin, float& spanEnd) const {
     const OctantBoxes& boxes = cellBoxes_[brick];
+    spanBegin = s0;
+    spanEnd = s1;
     if (boxes.whole)
         return true;
+    spanBegin = kInfinity;
+    spanEnd = -kInfinity;
     const glm::ivec3 base = kBrick * b;
     // The walk's crossings are exact to a few ulps of the index coordinates:
     // 1/64 of a cell, more where the coordinates are large.
@@ -149,10 +153,12 @@ bool BrickVolume::mayMeetValues(std::size_t brick, const glm::ivec3& b,
             sa = std::max(sa, std::min(ta, tb));
             sb = std::min(sb, std::max(ta, tb));
         }
-        if (sa <= sb)
-            return true;
+        if (sa <= sb) {
+            spanBegin = std::min(spanBegin, sa);
+            spanEnd = std::max(spanEnd, sb);
+        }
     }
-    return false;
+    return spanBegin <= spanEnd;
 }
 
 std::int64_t BrickVolume::find(const glm::ivec3& b) const {
@@ -400,10 +406,11 @@ OpticalDepths BrickVolume::integrate(const Vec3f& origin, const Vec3f& dir, floa
     walkBricks(O, dir, tStart * invH_, std::isinf(tEnd) ? kInfinity : tEnd * invH_,
                [&](std::size_t brick, const glm::ivec3& b, float s, float sExit) {
                    touched = true;
-                   if (!mayMeetValues(brick, b, line, s, sExit))
+                   float sa, sb;
+                   if (!valueSpan(brick, b, line, s, sExit, sa, sb))
                        return true;
                    forEachPiece(
-                       brick, b, line, s, sExit, [](float) { return kInfinity; },
+                       brick, b, line, sa, sb, [](float) { return kInfinity; },
                        [&](float s0, float s1, const Lanes& f0, const Lanes& fm, const Lanes& f1) {
                            addSimpson(sum, f0, fm, f1, (s1 - s0) / 6.0f);
                        });
@@ -458,13 +465,14 @@ void BrickVolume::integrateCumulative(const Vec3f& origin, const Vec3f& dir, flo
                    // sum and what is recorded as they were (the samples it
                    // would record repeat the last value; the next brick's
                    // skipTo records the same ones either side of a change).
-                   if (!mayMeetValues(brick, b, line, s, sExit))
+                   float sa, sb;
+                   if (!valueSpan(brick, b, line, s, sExit, sa, sb))
                        return true;
-                   skipTo(s);
-                   recordUpTo(s);
+                   skipTo(sa);
+                   recordUpTo(sa);
                    // Pieces end at sample positions, where the running sum is recorded.
                    forEachPiece(
-                       brick, b, line, s, sExit,
+                       brick, b, line, sa, sb,
                        [&](float t) {
                            const float k = std::floor((t - sStart) / sStep) + 1.0f;
                            const float split = sStart + k * sStep;
