@@ -11,6 +11,8 @@
 //   render_bench                                   # everything
 //   render_bench --benchmark_filter=Head1080p      # the 1.4M-segment case alone (clean peak
 //   memory)
+//   render_bench --benchmark_filter=Turntable      # four frames, alone and sharing (FrameReuse)
+#include <hairvox/core/math.h>
 #include <hairvox/film/image_file.h>
 #include <hairvox/pipeline/pipeline.h>
 #include <hairvox/render/rasterizer.h>
@@ -18,6 +20,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include <cmath>
 #include <filesystem>
 #include <sys/resource.h>
 #include <unistd.h>
@@ -133,6 +136,39 @@ void BM_MeshCost1080p(benchmark::State& state) {
     state.counters["fragments"] = double(r.raster->fragments);
 }
 BENCHMARK(BM_MeshCost1080p)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+
+/// A turntable of the default scene: four frames, the camera 20° apart
+/// around the head, rendered one after another (no files). Arg 0: each frame
+/// as if alone; 1: the frames share the fiber grid and the lights'
+/// preparation (FrameReuse, what `hairvox render a.json b.json ...` does).
+/// frame_s is a frame's mean, later_frame_s that of the frames after the first.
+void BM_Turntable(benchmark::State& state) {
+    Scene scene = defaultScene();
+    scene.output.exr.clear();
+    scene.output.png.clear();
+    const Vec3f centre = scene.camera.lookAt, offset = scene.camera.position - centre;
+    constexpr int kFrames = 4;
+    double total = 0, later = 0;
+    for (auto _ : state) {
+        FrameReuse reuse;
+        for (int f = 0; f < kFrames; ++f) {
+            const float a = radians(20.0f * float(f));
+            scene.camera.position =
+                centre + Vec3f(offset.x * std::cos(a) - offset.z * std::sin(a), offset.y,
+                               offset.x * std::sin(a) + offset.z * std::cos(a));
+            const SceneRender r =
+                renderScene(scene, {}, false, state.range(0) == 1 ? &reuse : nullptr);
+            total += r.times.total();
+            if (f > 0)
+                later += r.times.total();
+        }
+    }
+    const auto runs = double(state.iterations());
+    state.counters["frame_s"] = total / (runs * kFrames);
+    state.counters["later_frame_s"] = later / (runs * (kFrames - 1));
+    state.counters["peak_MiB"] = peakResidentMiB();
+}
+BENCHMARK(BM_Turntable)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 
 void BM_WriteOutput(benchmark::State& state) {
     const Scene scene = defaultScene();
