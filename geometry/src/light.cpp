@@ -25,6 +25,10 @@ Light Light::point(const Vec3f& position) {
     return light;
 }
 
+void Light::hashInto(Hasher& hasher) const {
+    hasher.value(kind).value(direction).value(position).value(color).value(intensity);
+}
+
 Rgb Light::irradiance(float distance) const {
     const Rgb e = intensity * color;
     if (kind == Kind::Directional)

@@ -327,13 +327,11 @@ std::uint64_t modelKey(std::uint64_t groomContent, std::uint64_t grid, const Sce
     h.value(groomContent).value(grid);
     for (const FiberParams& fiber : groom.palette.fibers)
         fiber.hashInto(h);
-    h.value(scene.dualScattering.d_f).value(scene.dualScattering.d_b);
+    scene.dualScattering.hashInto(h);
     scene.fiberScale.hashInto(h);
     h.value(scene.globalTermMode);
     h.value(scene.exact.rays).value(scene.exact.radius).value(scene.exact.seed);
-    const GridOptions& g = options.grid;
-    h.value(g.orientation).value(g.estimator).value(g.evaluation);
-    h.value(g.startOffset).value(g.cacheSpacing).value(g.fiberSampleSpacing);
+    options.grid.hashInto(h);
     h.value(scene.fiberSampleSpacing.has_value()).value(scene.fiberSampleSpacing.value_or(0.0f));
     h.string(scene.groom.file.string());
     if (surfaces.scene) {
@@ -349,11 +347,11 @@ std::uint64_t modelKey(std::uint64_t groomContent, std::uint64_t grid, const Sce
     return h.digest();
 }
 
-/// A light's prepared term under a model: everything of the light but its name.
+/// A light's prepared term under a model.
 std::uint64_t lightKey(std::uint64_t model, const Light& light) {
     Hasher h;
-    h.value(model).value(light.kind).value(light.direction).value(light.position);
-    h.value(light.color).value(light.intensity);
+    h.value(model);
+    light.hashInto(h);
     return h.digest();
 }
 
@@ -732,7 +730,7 @@ std::string pathTraceHash(const Scene& scene, const SceneGroom& groom,
     for (const FiberParams& fiber : groom.palette.fibers)
         fiber.hashInto(h);
     for (const Light& l : scene.lights) {
-        h.value(l.kind).value(l.direction).value(l.position).value(l.color).value(l.intensity);
+        l.hashInto(h);
         h.string(l.name);
     }
     const CameraParams& c = scene.camera;

@@ -56,6 +56,10 @@ void FiberParams::hashInto(Hasher& hasher) const {
     hasher.value(causticWidth).value(causticGain).value(causticFade).value(causticMaxWidth);
 }
 
+void DualScatteringParams::hashInto(Hasher& hasher) const {
+    hasher.value(d_f).value(d_b);
+}
+
 std::ostream& operator<<(std::ostream& os, const FiberParams& p) {
     return os << "FiberParams(eta=" << p.eta << ", sigma_a=" << p.sigma_a
               << ", alpha_R=" << degrees(p.alpha_R) << "deg, beta_R=" << degrees(p.beta_R)

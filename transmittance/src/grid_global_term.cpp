@@ -41,6 +41,11 @@ void GridOptions::validate(const FiberGrid& grid) const {
         throw InputError("the fiber grid has no density/orientation grids or no voxel size");
 }
 
+void GridOptions::hashInto(Hasher& hasher) const {
+    hasher.value(orientation).value(estimator).value(evaluation);
+    hasher.value(startOffset).value(cacheSpacing).value(fiberSampleSpacing);
+}
+
 std::ostream& operator<<(std::ostream& os, const GridOptions& options) {
     return os << "GridOptions(orientation=" << toString(options.orientation)
               << ", estimator=" << toString(options.estimator)

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <hairvox/core/enum_names.h>
+#include <hairvox/core/hash.h>
 #include <hairvox/core/rgb.h>
 #include <hairvox/core/vecmath.h>
 
@@ -53,6 +54,8 @@ struct Light {
     Rgb irradiance(float distance) const;
     /// Emits nothing (black or zero intensity): integrators skip it.
     bool isDark() const { return !(intensity > 0) || color.isBlack(); }
+    /// What it lights with: every field but the name (which only names its AOVs).
+    void hashInto(Hasher& hasher) const;
 };
 
 inline constexpr EnumNames<Light::Kind, 2> kLightKindNames{{{

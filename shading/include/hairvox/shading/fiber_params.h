@@ -59,6 +59,7 @@ struct DualScatteringParams {
     float d_b = 1.0f; ///< backward scattering density factor, [0, 1]
 
     void validate() const;
+    void hashInto(Hasher& hasher) const;
 };
 
 std::ostream& operator<<(std::ostream& os, const DualScatteringParams& p);

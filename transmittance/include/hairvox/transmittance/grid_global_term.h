@@ -110,6 +110,8 @@ struct GridOptions {
     float fiberSampleSpacing = 1.0f;
 
     void validate(const FiberGrid& grid) const;
+    /// Every option (they all change what the grid modes compute).
+    void hashInto(Hasher& hasher) const;
 };
 
 std::ostream& operator<<(std::ostream& os, const GridOptions& options);
