@@ -1,4 +1,5 @@
 #include "dual_scattering_fragment_shader.h"
+#include "frame_reuse.h"
 #include "surfaces.h"
 
 #include <hairvox/core/error.h>
@@ -264,18 +265,6 @@ SceneGroom loadGroom(const Scene& scene) {
     return g;
 }
 
-struct FrameReuse::State {
-    /// The last frame's assets (its grid, model and groom), and the keys
-    /// they were built under; null before the first frame.
-    std::shared_ptr<const SceneAssets> assets;
-    std::uint64_t gridKey = 0, modelKey = 0;
-    /// Its lights' prepared terms (of assets->globalTerm), by lightKey().
-    std::map<std::uint64_t, std::shared_ptr<const LightGlobalTerm>> lights;
-};
-
-FrameReuse::FrameReuse()
-    : state_(std::make_unique<State>()) {}
-FrameReuse::~FrameReuse() = default;
 
 namespace {
 
@@ -293,66 +282,6 @@ SplatOptions splatOptions(const Scene& scene, const PipelineOptions& options) {
             splat.memoryBudgetBytes, options.maxMemoryBytes > used ? options.maxMemoryBytes - used : 1);
     }
     return splat;
-}
-
-/// The groom as every stage reads it: its points, diameters and fiber types.
-std::uint64_t groomKey(const Groom& groom) {
-    Hasher h;
-    h.value(contentHash(groom));
-    h.values(std::span<const float>(groom.thickness));
-    h.values(std::span<const std::uint8_t>(groom.fiberType));
-    return h.digest();
-}
-
-/// What splatStrands() makes the fiber grid from: the groom, and the options
-/// that change the grid (not the memory budget, threads or progress).
-std::uint64_t gridKey(std::uint64_t groom, const SplatOptions& splat) {
-    Hasher h;
-    h.value(groom);
-    h.value(splat.voxelSize).value(splat.storeOrientationTensor);
-    splat.fiberScale.hashInto(h);
-    h.string(splat.sourceFile); // recorded in the grid's metadata
-    return h.digest();
-}
-
-/// What the rest of a frame's assets are made from besides the groom and
-/// the grid (0 in exact mode): the tables and crossing tables (each fiber
-/// type's optics, d_b), the model's settings (fiber scale, d_f, the
-/// surfaces' contents and colours), the global-term mode with its options,
-/// and the names the groom's and meshes' messages quote.
-std::uint64_t modelKey(std::uint64_t groomContent, std::uint64_t grid, const Scene& scene,
-                       const PipelineOptions& options, const SceneGroom& groom,
-                       const SceneSurfaces& surfaces) {
-    Hasher h;
-    h.value(groomContent).value(grid);
-    for (const FiberParams& fiber : groom.palette.fibers)
-        fiber.hashInto(h);
-    scene.dualScattering.hashInto(h);
-    scene.fiberScale.hashInto(h);
-    h.value(scene.globalTermMode);
-    h.value(scene.exact.rays).value(scene.exact.radius).value(scene.exact.seed);
-    options.grid.hashInto(h);
-    h.value(scene.fiberSampleSpacing.has_value()).value(scene.fiberSampleSpacing.value_or(0.0f));
-    h.string(scene.groom.file.string());
-    if (surfaces.scene) {
-        for (const Sphere& sphere : surfaces.scene->spheres())
-            h.value(sphere.center).value(sphere.radius);
-        for (const TriangleMesh& mesh : surfaces.scene->meshes())
-            h.value(mesh.contentHash());
-    }
-    for (const Rgb& albedo : surfaces.albedo)
-        h.value(albedo);
-    for (const MeshSource& mesh : scene.meshes)
-        h.string(mesh.file.string());
-    return h.digest();
-}
-
-/// A light's prepared term under a model.
-std::uint64_t lightKey(std::uint64_t model, const Light& light) {
-    Hasher h;
-    h.value(model);
-    light.hashInto(h);
-    return h.digest();
 }
 
 /// What prepareAssets() did: built the assets, or found them all in the
@@ -377,12 +306,12 @@ FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, Sc
     assets->times.load = secondsSince(start);
     throwIfInterrupted();
 
-    const std::uint64_t groom = reuse ? groomKey(assets->groom.groom) : 0;
+    const std::uint64_t groom = reuse ? detail::groomKey(assets->groom.groom) : 0;
     if (scene.globalTermMode != GlobalTermMode::Exact) {
         checkVoxelSizeForGroom(scene, assets->groom.groom);
         const SplatOptions splat = splatOptions(scene, options);
         if (reuse)
-            out.gridKey = gridKey(groom, splat);
+            out.gridKey = detail::gridKey(groom, splat);
         if (reuse && reuse->assets && reuse->assets->grid && reuse->gridKey == out.gridKey) {
             out.gridReused = true;
         } else {
@@ -397,7 +326,7 @@ FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, Sc
     }
     if (reuse) {
         out.modelKey =
-            modelKey(groom, out.gridKey, scene, options, assets->groom, assets->surfaces);
+            detail::modelKey(groom, out.gridKey, scene, options, assets->groom, assets->surfaces);
         if (reuse->assets && reuse->modelKey == out.modelKey) {
             // The same groom, surfaces, grid and model: the frame before's.
             out.loadSeconds = assets->times.load;
@@ -498,7 +427,7 @@ SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& opti
     std::vector<std::uint64_t> lightKeys(lightCount);
     if (reuse) { // the frame before's lights this frame does not have are freed first
         for (std::size_t l = 0; l < lightCount; ++l)
-            lightKeys[l] = lightKey(frame.modelKey, scene.lights[l]);
+            lightKeys[l] = detail::lightKey(frame.modelKey, scene.lights[l]);
         std::erase_if(reuse->lights, [&](const auto& entry) {
             return std::find(lightKeys.begin(), lightKeys.end(), entry.first) == lightKeys.end();
         });

@@ -169,7 +169,7 @@ struct SceneRender {
 /// computed from is what it was for the frame before. The keys are contents,
 /// not names: the groom's points, diameters and fiber types as loaded, the
 /// surfaces' triangles, and every setting the splat and the lights'
-/// preparation read (gridKey(), modelKey() in pipeline.cpp). So a camera
+/// preparation read (pipeline/src/frame_reuse.h). So a camera
 /// moving around a still groom under still lights (a turntable) splats and
 /// prepares once; a frame that moves one light prepares that light again; a
 /// new colour keeps the grid and prepares the lights; a groom file rewritten
