@@ -184,7 +184,7 @@ public:
     FrameReuse(const FrameReuse&) = delete;
     FrameReuse& operator=(const FrameReuse&) = delete;
 
-    struct State; ///< (pipeline.cpp)
+    struct State; ///< (pipeline/src/frame_reuse.h)
 
 private:
     friend SceneRender renderScene(const Scene&, const PipelineOptions&, bool, FrameReuse*);
