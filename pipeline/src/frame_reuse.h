@@ -20,6 +20,12 @@ struct FrameReuse::State {
     std::uint64_t gridKey = 0, modelKey = 0;
     /// Its lights' prepared terms (of assets->globalTerm), by lightKey().
     std::map<std::uint64_t, std::shared_ptr<const LightGlobalTerm>> lights;
+
+    /// Forgets the frame before (its memory is freed unless this frame shares it).
+    void release() {
+        lights.clear();
+        assets.reset();
+    }
 };
 
 namespace detail {

@@ -265,7 +265,6 @@ SceneGroom loadGroom(const Scene& scene) {
     return g;
 }
 
-
 namespace {
 
 SplatOptions splatOptions(const Scene& scene, const PipelineOptions& options) {
@@ -290,7 +289,6 @@ struct FrameAssets {
     const SceneAssets* reused = nullptr;
     bool gridReused = false;
     std::uint64_t gridKey = 0, modelKey = 0; ///< when reuse was asked for
-    double loadSeconds = 0;
 };
 
 /// loadSceneAssets() into `assets` (empty, where they will stay: the model
@@ -315,10 +313,8 @@ FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, Sc
         if (reuse && reuse->assets && reuse->assets->grid && reuse->gridKey == out.gridKey) {
             out.gridReused = true;
         } else {
-            if (reuse) {
-                reuse->lights.clear();
-                reuse->assets.reset();
-            }
+            if (reuse)
+                reuse->release();
             start = Clock::now();
             assets->grid = splatStrands(assets->groom.groom, splat);
             assets->times.voxelize = secondsSince(start);
@@ -329,14 +325,12 @@ FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, Sc
             detail::modelKey(groom, out.gridKey, scene, options, assets->groom, assets->surfaces);
         if (reuse->assets && reuse->modelKey == out.modelKey) {
             // The same groom, surfaces, grid and model: the frame before's.
-            out.loadSeconds = assets->times.load;
             out.reused = reuse->assets.get();
             return out;
         }
         if (out.gridReused) // the VDB grids are shared, not copied
             assets->grid = reuse->assets->grid;
-        reuse->lights.clear();
-        reuse->assets.reset();
+        reuse->release();
     }
 
     start = Clock::now();
@@ -377,7 +371,6 @@ FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, Sc
         break;
     }
     assets->times.globalTerm = secondsSince(start);
-    out.loadSeconds = assets->times.load;
     return out;
 }
 
@@ -398,8 +391,8 @@ SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& opti
     const FrameAssets frame = prepareAssets(scene, options, built.get(), reuse);
     const SceneAssets* assets = frame.reused ? frame.reused : built.get();
     if (frame.reused) {
+        result.times.load = built->times.load;
         built.reset(); // this frame's groom and surfaces, loaded for their keys
-        result.times.load = frame.loadSeconds;
     } else {
         result.times = built->times;
         if (reuse) { // for the next frame (the frame before's is gone)
