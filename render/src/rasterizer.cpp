@@ -360,6 +360,7 @@ struct TileScratch {
     std::vector<float> probeResults;     ///< per probed segment: 3 × stride floats
     std::vector<std::uint32_t> probeOf;  ///< per local segment: its smooth probe, or none
     std::vector<float> pixelSum; ///< per pixel: stride floats of weighted sums
+    raster::CoverageCells coverageCells; ///< rasterizeRibbon's, all 0 between ribbons
 };
 
 struct TileResult {
@@ -557,7 +558,7 @@ private:
                     continue;
                 }
                 raster::rasterizeRibbon(
-                    r, x0_, y0_, x1_, y1_,
+                    r, x0_, y0_, x1_, y1_, s_.coverageCells,
                     [&](int x, int y, float coverage) {
                         Fragment f;
                         r.locate(Vec2d(x + 0.5, y + 0.5), f.t, f.depth);

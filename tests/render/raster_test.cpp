@@ -1,3 +1,4 @@
+#include "../../render/src/ribbon.h"
 #include "film/film_bytes.h"
 #include "render/test_shaders.h"
 
@@ -11,6 +12,7 @@
 #include <cmath>
 #include <cstring>
 #include <numeric>
+#include <random>
 #include <span>
 
 namespace hairvox {
@@ -275,6 +277,72 @@ TEST(RasterCoverage, EachPixelGetsTheAreaOfRibbonAndPixel) {
         EXPECT_LT(worst, 1e-4);
     }
     EXPECT_GT(compared, 900);
+}
+
+// The accumulation itself (raster::rasterizePolygon), on polygons no ribbon
+// test reaches: random convex triangles and quads, from a hundredth of a
+// pixel to wider than the tile, partly outside it on every side (clipped to
+// it: up to 8 vertices), near
+// horizontal and vertical edges, at large raster coordinates; and one
+// scratch kept from polygon to polygon, as a tile keeps it.
+TEST(RasterCoverage, AccumulatedAreasAreTheClippedAreasOfEachPixel) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    raster::CoverageCells cells;
+    double worst = 0;
+    int emitted = 0;
+    for (int trial = 0; trial < 400; ++trial) {
+        const int x0 = 32 * (trial % 7) + (trial % 3 == 0 ? 4064 : 0), y0 = 32 * (trial % 5);
+        const int x1 = x0 + 32, y1 = y0 + 32;
+        const double scale = std::pow(10.0, -2.0 + 3.7 * unit(rng)); // 0.01 to 50 pixels
+        const Vec2d centre(x0 - 4 + 40 * unit(rng), y0 - 4 + 40 * unit(rng));
+        // A convex polygon: points on an ellipse at sorted angles, flattened
+        // to near-horizontal or near-vertical edges now and then.
+        const int n = 3 + trial % 2; // clipToBox() below adds up to 4 vertices
+        std::vector<double> angles(std::size_t(n), 0.0);
+        for (double& a : angles)
+            a = 2 * Pi * unit(rng);
+        std::sort(angles.begin(), angles.end());
+        const double squash = trial % 4 == 1 ? 1e-3 : 1.0;
+        raster::Polygon poly;
+        poly.n = n;
+        std::vector<Vec2d> points;
+        for (int k = 0; k < n; ++k) {
+            const double a = angles[std::size_t(k)];
+            Vec2d p = centre + scale * Vec2d(std::cos(a), squash * std::sin(a));
+            if (trial % 8 == 3) { // transposed: near vertical
+                std::swap(p.x, p.y);
+                p += Vec2d(x0 - y0, y0 - x0);
+            }
+            poly.v[k] = p;
+            points.push_back(p);
+        }
+        // What the tile's clip to its box ± 1 gives rasterizeRibbon.
+        const raster::Polygon clipped = raster::clipToBox(poly, x0 - 1, y0 - 1, x1 + 1, y1 + 1);
+        std::vector<double> got(32 * 32, 0.0);
+        auto emit = [&](int x, int y, float coverage) {
+            ASSERT_TRUE(x >= x0 && x < x1 && y >= y0 && y < y1);
+            got[std::size_t((y - y0) * 32 + (x - x0))] += double(coverage);
+            ++emitted;
+        };
+        auto wanted = [](int, int) { return true; };
+        raster::rasterizePolygon(clipped, x0, y0, x1, y1, cells, emit, wanted);
+        for (int y = y0; y < y1; ++y)
+            for (int x = x0; x < x1; ++x) {
+                const double expected = std::min(areaInPixel(points, x, y), 1.0);
+                const double g = got[std::size_t((y - y0) * 32 + (x - x0))];
+                // Below 1e-7 pixel² nothing is emitted; floats round at ~6e-8.
+                worst = std::max(worst, std::abs(g - expected));
+                if (expected > 2e-7) {
+                    EXPECT_NEAR(g, expected, 1e-6) << "trial " << trial << " pixel " << x << "," << y;
+                }
+            }
+    }
+    EXPECT_LT(worst, 1e-6);
+    EXPECT_GT(emitted, 5000);
+    // Every cell went back to 0 after its polygon.
+    for (double c : cells.acc)
+        ASSERT_EQ(c, 0.0);
 }
 
 TEST(RasterCoverage, FiberLeavingTheImageIsClippedNotLost) {
