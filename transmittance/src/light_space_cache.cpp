@@ -169,7 +169,7 @@ std::size_t LightSpaceCache::memoryBytes() const {
            samples_.bytes();
 }
 
-Vec3f LightSpaceCache::toLattice(const Vec3f& p) const {
+inline Vec3f LightSpaceCache::toLattice(const Vec3f& p) const {
     if (!perspective_)
         return {glm::dot(p, e1_) / du_ - float(i0_), glm::dot(p, e2_) / du_ - float(j0_),
                 (glm::dot(p, axis_) - sBase_) / h_};
@@ -189,7 +189,7 @@ Vec3f LightSpaceCache::lineOrigin(int i, int j, Vec3f& dir) const {
     return origin_ + sBase_ * dir;
 }
 
-LightSpaceCache::LineRead LightSpaceCache::alongLine(std::uint64_t r0, std::uint64_t r1,
+inline LightSpaceCache::LineRead LightSpaceCache::alongLine(std::uint64_t r0, std::uint64_t r1,
                                                     float s) const {
     if (r0 == r1 || s < float(runs_[r0].k0))
         return {}; // before the line's first change: zero
@@ -207,7 +207,7 @@ LightSpaceCache::LineRead LightSpaceCache::alongLine(std::uint64_t r0, std::uint
     return {samples + k, samples + k + 1, local - float(k)};
 }
 
-Lanes LightSpaceCache::value(const LineRead& read) {
+inline Lanes LightSpaceCache::value(const LineRead& read) {
     if (!read.a)
         return {};
     if (!read.b)
