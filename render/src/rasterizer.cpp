@@ -551,6 +551,13 @@ private:
             }
             const std::size_t end = std::min(n, begin + kSegmentsPerStep);
             for (std::size_t j = begin; j < end; ++j) {
+                // Ribbons are read in depth order, scattered over the tile's
+                // array: fetch the next ones while this one is covered.
+                if (j + kPrefetchAhead < n) {
+                    const ScreenRibbon* next = &s_.ribbons[s_.order[j + kPrefetchAhead]];
+                    prefetch(&next->s0);
+                    prefetch(&next->yMax);
+                }
                 const std::uint32_t local = s_.order[j];
                 const ScreenRibbon& r = s_.ribbons[local];
                 if (!anyOpenUnder(r)) {
