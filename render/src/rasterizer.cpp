@@ -355,7 +355,6 @@ struct TileScratch {
     std::vector<float> vertexResults;        ///< per vertex slot: stride floats
     std::vector<ShadingPoint> points;
     std::vector<float> results;  ///< per point of a batch: stride floats
-    std::vector<float> lerped;   ///< one interpolated result
     std::vector<std::uint32_t> probed;   ///< adaptive rate: local segments shaded at t = 0, ½, 1
     std::vector<float> probeResults;     ///< per probed segment: 3 × stride floats
     std::vector<std::uint32_t> probeOf;  ///< per local segment: its smooth probe, or none
@@ -866,13 +865,11 @@ private:
             s_.slotPoint.size(),
             [&](std::size_t j) { return pointAtVertex(s_.slotPoint[j], s_.slotStrand[j]); },
             "at a strand vertex", s_.vertexResults);
-        s_.lerped.resize(stride_);
         result_.interpolated += fragments.size();
         for (const Visible& v : fragments) {
             const float* a =
                 s_.vertexResults.data() + std::size_t(s_.vertexSlot[v.local]) * stride_;
-            lerpResult(v.t, a, a + stride_);
-            accumulate(v, s_.lerped.data());
+            accumulateLerp(v, v.t, a, a + stride_);
         }
     }
 
@@ -916,7 +913,6 @@ private:
 
         // The fragments of the other segments, shaded in segment order.
         s_.grouped.clear();
-        s_.lerped.resize(stride_);
         for (const Visible& v : s_.visible) {
             const std::uint32_t p = s_.probeOf[v.local];
             if (p == kNoSlot) {
@@ -927,18 +923,20 @@ private:
             const float* m = a + stride_;
             const float u = 2.0f * v.t;
             if (u > 1.0f)
-                lerpResult(u - 1.0f, m, m + stride_);
+                accumulateLerp(v, u - 1.0f, m, m + stride_);
             else
-                lerpResult(u, a, m);
-            accumulate(v, s_.lerped.data());
+                accumulateLerp(v, u, a, m);
         }
         shadeEach(s_.grouped);
     }
 
-    /// s_.lerped ← (1 − u)·a + u·b, one shader result.
-    void lerpResult(float u, const float* a, const float* b) {
+    /// accumulate() of the result (1 − u)·a + u·b, interpolated as it is added.
+    void accumulateLerp(const Visible& v, float u, const float* __restrict a,
+                        const float* __restrict b) {
+        float* __restrict sum = s_.pixelSum.data() + std::size_t(v.pixel) * stride_;
+        const float w = v.weight;
         for (std::size_t k = 0; k < stride_; ++k)
-            s_.lerped[k] = hairvox::lerp(u, a[k], b[k]);
+            sum[k] += w * hairvox::lerp(u, a[k], b[k]);
     }
 
     /// Radiance layers get the premultiplied sums (and add to the beauty);
