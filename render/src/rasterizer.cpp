@@ -354,11 +354,11 @@ struct TileScratch {
     std::vector<std::uint32_t> slotStrand;   ///< per vertex slot: its strand
     std::vector<float> vertexResults;        ///< per vertex slot: stride floats
     std::vector<ShadingPoint> points;
-    std::vector<float> results;  ///< per point of a batch: stride floats
+    std::vector<float> results;          ///< per point of a batch: stride floats
     std::vector<std::uint32_t> probed;   ///< adaptive rate: local segments shaded at t = 0, ½, 1
     std::vector<float> probeResults;     ///< per probed segment: 3 × stride floats
     std::vector<std::uint32_t> probeOf;  ///< per local segment: its smooth probe, or none
-    std::vector<float> pixelSum; ///< per pixel: stride floats of weighted sums
+    std::vector<float> pixelSum;         ///< per pixel: stride floats of weighted sums
     raster::CoverageCells coverageCells; ///< rasterizeRibbon's, all 0 between ribbons
 };
 

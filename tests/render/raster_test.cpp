@@ -325,7 +325,9 @@ TEST(RasterCoverage, AccumulatedAreasAreTheClippedAreasOfEachPixel) {
             got[std::size_t((y - y0) * 32 + (x - x0))] += double(coverage);
             ++emitted;
         };
-        auto wanted = [](int, int) { return true; };
+        auto wanted = [](int, int) {
+            return true;
+        };
         raster::rasterizePolygon(clipped, x0, y0, x1, y1, cells, emit, wanted);
         for (int y = y0; y < y1; ++y)
             for (int x = x0; x < x1; ++x) {
@@ -334,7 +336,8 @@ TEST(RasterCoverage, AccumulatedAreasAreTheClippedAreasOfEachPixel) {
                 // Below 1e-7 pixel² nothing is emitted; floats round at ~6e-8.
                 worst = std::max(worst, std::abs(g - expected));
                 if (expected > 2e-7) {
-                    EXPECT_NEAR(g, expected, 1e-6) << "trial " << trial << " pixel " << x << "," << y;
+                    EXPECT_NEAR(g, expected, 1e-6)
+                        << "trial " << trial << " pixel " << x << "," << y;
                 }
             }
     }

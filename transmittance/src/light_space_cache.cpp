@@ -190,7 +190,7 @@ Vec3f LightSpaceCache::lineOrigin(int i, int j, Vec3f& dir) const {
 }
 
 inline LightSpaceCache::LineRead LightSpaceCache::alongLine(std::uint64_t r0, std::uint64_t r1,
-                                                    float s) const {
+                                                            float s) const {
     if (r0 == r1 || s < float(runs_[r0].k0))
         return {}; // before the line's first change: zero
     // The last run starting at or before s (a line has a few).
