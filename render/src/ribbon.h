@@ -92,6 +92,8 @@ std::optional<ScreenRibbon> projectRibbon(const Camera& camera, const Vec3f& p0,
 /// The cells of one polygon's coverage (rasterizePolygon), kept by the caller
 /// from polygon to polygon: every cell is 0 between calls, and each row's
 /// touched span is reset, so that a polygon clears only what it touched.
+/// (An exception thrown by emit() leaves them dirty: a tile's scratch, which
+/// a failed render discards.)
 struct CoverageCells {
     std::vector<double> acc; ///< rows of `width` cells
     std::vector<int> lo, hi; ///< per row: the first and last cell an edge touched
@@ -119,7 +121,7 @@ void rasterizeRibbon(const ScreenRibbon& ribbon, int x0, int y0, int x1, int y1,
 
 // --- implementation --------------------------------------------------------
 
-/// A convex polygon of up to 8 vertices (a quad clipped by three lines has ≤ 7).
+/// A convex polygon of up to 8 vertices (a quad clipped by four lines).
 struct Polygon {
     Vec2d v[8];
     int n = 0;
@@ -233,6 +235,8 @@ template <typename Emit, typename Wanted>
 void rasterizePolygon(const Polygon& poly, int x0, int y0, int x1, int y1, CoverageCells& cells,
                       Emit& emit, Wanted& wanted) {
     constexpr double minCoverage = 1e-7;
+    if (poly.n < 3)
+        return; // clipped away
     double xMin = poly.v[0].x, xMax = xMin, yMin = poly.v[0].y, yMax = yMin;
     for (int k = 1; k < poly.n; ++k) {
         xMin = std::min(xMin, poly.v[k].x);
@@ -244,7 +248,7 @@ void rasterizePolygon(const Polygon& poly, int x0, int y0, int x1, int y1, Cover
     const int rowEnd = std::min(y1, static_cast<int>(std::ceil(yMax)));
     // Cells from the polygon's left end: those left of x0 carry its area into the sum.
     const int colBase = static_cast<int>(std::floor(xMin));
-    if (poly.n < 3 || rowBegin >= rowEnd || std::max(x0, colBase) >= x1)
+    if (rowBegin >= rowEnd || std::max(x0, colBase) >= x1)
         return;
     const int rows = rowEnd - rowBegin;
     cells.prepare(rows, static_cast<int>(std::ceil(xMax)) - colBase + 2);
