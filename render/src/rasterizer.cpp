@@ -538,7 +538,8 @@ private:
     void rasterizeAndComposite() {
         const std::size_t n = s_.order.size();
         auto open = [&](int x, int y) {
-            if (!s_.pixels[pixelIndex(x, y)].closed)
+            // The row's mask (cleared with pixels[].closed): one word, not a PixelState.
+            if ((openRows_[std::size_t(y - y0_)] >> (x - x0_)) & 1u)
                 return true;
             ++result_.behindOpaque;
             return false;
