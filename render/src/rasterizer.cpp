@@ -10,6 +10,7 @@
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
@@ -727,8 +728,16 @@ private:
     void shadeBatch(std::size_t count, Where&& where) {
         throwIfInterrupted(); // an expensive shader (exact mode) makes a tile long
         s_.results.resize(count * stride_);
-        ctx_.shader.shade(std::span(s_.points.data(), count),
-                          std::span(s_.results.data(), count * stride_));
+        // Isolated: a shader may run its own parallel loops (the global
+        // term's lookups), and oneTBB allows a thread waiting in one to take
+        // another tile's task ("Work Isolation"), which would reuse this
+        // thread's scratch (s_, and the shader's thread-local batches) under
+        // this tile. (Debian's oneTBB 2021.8 was not seen to do it: no
+        // re-entry in 2,000 nested loops at 2, 4 and 8 threads.)
+        tbb::this_task_arena::isolate([&] {
+            ctx_.shader.shade(std::span(s_.points.data(), count),
+                              std::span(s_.results.data(), count * stride_));
+        });
         result_.shadingPoints += count;
         for (std::size_t i = 0; i < count; ++i) {
             const std::span<float> r(s_.results.data() + i * stride_, stride_);

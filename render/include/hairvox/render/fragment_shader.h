@@ -105,7 +105,9 @@ public:
     /// as layout() says. Results must depend only on the point (not on the
     /// batch); radiance must be finite and non-negative, averages finite — the
     /// rasterizer rejects anything else and reports it. Called concurrently
-    /// from several threads.
+    /// from several threads, each call in its own TBB work isolation: a
+    /// shader may run parallel loops, and a thread waiting in them runs only
+    /// their tasks, so thread-local state survives them.
     virtual void shade(std::span<const ShadingPoint> points, std::span<float> out) const = 0;
 };
 
