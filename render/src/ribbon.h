@@ -149,7 +149,8 @@ void clip(const Polygon& in, double c, Polygon& out) {
 }
 
 /// ⌈x⌉ for x ≥ 0 (a conversion and a compare: the x86-64 baseline has no
-/// rounding instruction, and std::ceil is a call).
+/// rounding instruction, and std::ceil is a longer sequence that also
+/// handles negative and huge values).
 inline int ceilNonNegative(double x) {
     const int i = static_cast<int>(x);
     return double(i) < x ? i + 1 : i;

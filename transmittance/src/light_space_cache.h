@@ -52,6 +52,9 @@ public:
     std::size_t memoryBytes() const;
 
 private:
+    // toLattice, alongLine and value are defined inline in light_space_cache.cpp,
+    // within lookup()'s loops (their small results stay in registers).
+
     /// Lattice coordinates of p: (u, v) across the lines, s along them (from the light).
     Vec3f toLattice(const Vec3f& p) const;
     /// A point of line (i, j) at lattice distance s.
