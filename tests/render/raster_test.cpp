@@ -282,9 +282,8 @@ TEST(RasterCoverage, EachPixelGetsTheAreaOfRibbonAndPixel) {
 // The accumulation itself (raster::rasterizePolygon), on polygons no ribbon
 // test reaches: random convex triangles and quads, from a hundredth of a
 // pixel to wider than the tile, partly outside it on every side (clipped to
-// it: up to 8 vertices), near
-// horizontal and vertical edges, at large raster coordinates; and one
-// scratch kept from polygon to polygon, as a tile keeps it.
+// it: up to 8 vertices), near horizontal and vertical edges, at large raster
+// coordinates; and one scratch kept from polygon to polygon, as a tile keeps it.
 TEST(RasterCoverage, AccumulatedAreasAreTheClippedAreasOfEachPixel) {
     std::mt19937 rng(11);
     std::uniform_real_distribution<double> unit(0.0, 1.0);
