@@ -93,8 +93,7 @@ void runCompare(const CompareOptions& opt) {
                 return ComparedImage::fromFilm(film, opt.layers, opt.mask);
             if (opt.what == "hair") {
                 ComparedImage image = hairRadianceOf(film);
-                const auto& mask = film.layer(opt.mask).data;
-                image.mask.assign(mask.begin(), mask.end());
+                image.mask = film.layer(opt.mask).dense();
                 return image;
             }
             return ComparedImage::beautyOf(film, opt.mask);

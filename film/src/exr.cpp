@@ -39,13 +39,14 @@ constexpr float kHalfMax = 65504.0f;
 /// Longest name of a channel or attribute without the file's long-names flag.
 constexpr std::size_t kShortNameLength = 31;
 
-/// One EXR channel: where its floats are in the film and how it is stored.
+/// One EXR channel: the film layer and channel its values are in, and how it
+/// is stored.
 struct ExrChannel {
     std::string name;
-    const float* first; ///< pixel (0, 0)
-    std::size_t stride; ///< floats between pixels (1 or 3)
-    bool half;          ///< stored as half (else float)
-    std::size_t offset; ///< bytes from a packed scanline's start to this channel's values
+    const FilmLayer* layer;
+    std::size_t channel; ///< within a pixel of the layer (0, or 0–2 for RGB)
+    bool half;           ///< stored as half (else float)
+    std::size_t offset;  ///< bytes from a packed scanline's start to this channel's values
 };
 
 /// The film's channels as an EXR scanline holds them: sorted by name (as
@@ -54,28 +55,34 @@ struct ExrChannel {
 class ExrLayout {
 public:
     explicit ExrLayout(const Film& film)
-        : width_(std::size_t(film.width())) {
+        : width_(film.width()) {
         static constexpr const char* rgb[3] = {"R", "G", "B"};
         for (const FilmLayer& l : film.layers()) {
             if (l.channels == 1) {
-                channels_.push_back({l.name, l.data.data(), 1, !l.fullPrecision, 0});
+                channels_.push_back({l.name, &l, 0, !l.fullPrecision, 0});
                 continue;
             }
-            for (int c = 0; c < 3; ++c)
-                channels_.push_back({l.name.empty() ? rgb[c] : l.name + "." + rgb[c],
-                                     l.data.data() + c, 3, !l.fullPrecision, 0});
+            for (std::size_t c = 0; c < 3; ++c)
+                channels_.push_back(
+                    {l.name.empty() ? rgb[c] : l.name + "." + rgb[c], &l, c, !l.fullPrecision, 0});
         }
         std::sort(channels_.begin(), channels_.end(), [](const ExrChannel& a, const ExrChannel& b) {
             return std::strcmp(a.name.c_str(), b.name.c_str()) < 0;
         });
-        // Half unless the layer asks for float or a value does not fit.
+        // Half unless the layer asks for float or a value does not fit (the
+        // tiles not held are zeros; a held tile's pixels outside the image too).
         tbb::parallel_for(std::size_t(0), channels_.size(), [&](std::size_t i) {
             ExrChannel& c = channels_[i];
-            c.half = c.half && detail::maxAbs(c.first, c.stride, film.pixelCount()) <= kHalfMax;
+            const FilmLayer& l = *c.layer;
+            for (int ty = 0; c.half && ty < l.tilesY(); ++ty)
+                for (int tx = 0; c.half && tx < l.tilesX(); ++tx)
+                    if (const float* t = l.tileOrNull(tx, ty))
+                        c.half = detail::maxAbs(t + c.channel, std::size_t(l.channels),
+                                                FilmLayer::kTilePixels) <= kHalfMax;
         });
         for (ExrChannel& c : channels_) {
             c.offset = lineBytes_;
-            lineBytes_ += width_ * (c.half ? sizeof(std::uint16_t) : sizeof(float));
+            lineBytes_ += std::size_t(width_) * (c.half ? sizeof(std::uint16_t) : sizeof(float));
         }
     }
 
@@ -85,19 +92,34 @@ public:
     /// Scanline y as the file stores it, before compression.
     void pack(int y, std::uint8_t* out) const {
         static_assert(std::endian::native == std::endian::little, "EXR files are little-endian");
+        constexpr int kTile = FilmLayer::kTileSize;
+        const auto row = std::size_t(y % kTile) * kTile;
         for (const ExrChannel& c : channels_) {
-            const float* src = c.first + std::size_t(y) * width_ * c.stride;
-            std::uint8_t* dst = out + c.offset;
-            if (c.half)
-                detail::toHalf(src, c.stride, width_, reinterpret_cast<std::uint16_t*>(dst));
-            else
-                for (std::size_t x = 0; x < width_; ++x)
-                    std::memcpy(dst + x * sizeof(float), src + x * c.stride, sizeof(float));
+            const FilmLayer& l = *c.layer;
+            const auto stride = std::size_t(l.channels);
+            const std::size_t valueBytes = c.half ? sizeof(std::uint16_t) : sizeof(float);
+            for (int tx = 0; tx < l.tilesX(); ++tx) {
+                const int x0 = tx * kTile;
+                const auto n = std::size_t(std::min(kTile, width_ - x0));
+                std::uint8_t* dst = out + c.offset + std::size_t(x0) * valueBytes;
+                const float* t = l.tileOrNull(tx, y / kTile);
+                if (!t) { // +0 as half and as float: zero bytes
+                    std::memset(dst, 0, n * valueBytes);
+                    continue;
+                }
+                const float* src = t + row * stride + c.channel;
+                if (c.half)
+                    detail::toHalf(src, stride, n, reinterpret_cast<std::uint16_t*>(dst));
+                else
+                    for (std::size_t x = 0; x < n; ++x)
+                        std::memcpy(dst + x * sizeof(float), src + x * stride, sizeof(float));
+            }
         }
     }
 
 private:
-    std::size_t width_, lineBytes_ = 0;
+    int width_;
+    std::size_t lineBytes_ = 0;
     std::vector<ExrChannel> channels_;
 };
 
@@ -375,14 +397,16 @@ Film filmFromExr(const ExrImage& image) {
             FilmLayer& l = film.layer(film.addLayer(layer, 3, true));
             const std::vector<float>&r = image.channels.at(prefix + "R"),
                   &g = image.channels.at(prefix + "G"), &b = image.channels.at(prefix + "B");
+            std::vector<float> rgbValues(3 * film.pixelCount());
             for (std::size_t p = 0; p < film.pixelCount(); ++p) {
-                l.data[3 * p] = r[p];
-                l.data[3 * p + 1] = g[p];
-                l.data[3 * p + 2] = b[p];
+                rgbValues[3 * p] = r[p];
+                rgbValues[3 * p + 1] = g[p];
+                rgbValues[3 * p + 2] = b[p];
             }
+            l.assign(rgbValues);
             continue;
         }
-        film.layer(film.addLayer(name, 1, true)).data.assign(values.begin(), values.end());
+        film.layer(film.addLayer(name, 1, true)).assign(values);
     }
     return film;
 }

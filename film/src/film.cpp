@@ -1,9 +1,71 @@
 #include <hairvox/core/error.h>
 #include <hairvox/film/film.h>
 
+#include <algorithm>
+#include <new>
 #include <stdexcept>
 
 namespace hairvox {
+
+FilmLayer::FilmLayer(std::string name_, int channels_, bool fullPrecision_, int width, int height)
+    : name(std::move(name_))
+    , channels(channels_)
+    , fullPrecision(fullPrecision_)
+    , width_(width)
+    , height_(height)
+    , tilesX_((width + kTileSize - 1) / kTileSize)
+    , tilesY_((height + kTileSize - 1) / kTileSize)
+    , tiles_(std::size_t(tilesX_) * std::size_t(tilesY_)) {}
+
+float* FilmLayer::tile(int tx, int ty) {
+    auto& t = tiles_[std::size_t(ty) * std::size_t(tilesX_) + std::size_t(tx)];
+    if (!t) {
+        // calloc: zeros without a pass of our own where the allocator hands
+        // out fresh pages.
+        t.reset(static_cast<float*>(std::calloc(tileFloats(), sizeof(float))));
+        if (!t)
+            throw std::bad_alloc();
+    }
+    return t.get();
+}
+
+std::size_t FilmLayer::tilesHeld() const {
+    return std::size_t(
+        std::count_if(tiles_.begin(), tiles_.end(), [](const auto& t) { return t != nullptr; }));
+}
+
+std::vector<float> FilmLayer::dense() const {
+    const auto c = std::size_t(channels);
+    std::vector<float> out(std::size_t(width_) * std::size_t(height_) * c, 0.0f);
+    for (int y = 0; y < height_; ++y)
+        for (int tx = 0; tx < tilesX_; ++tx)
+            if (const float* t = tileOrNull(tx, y / kTileSize)) {
+                const int x0 = tx * kTileSize, n = std::min(kTileSize, width_ - x0);
+                std::copy_n(t + offset(x0, y), std::size_t(n) * c,
+                            out.begin() +
+                                std::ptrdiff_t(
+                                    (std::size_t(y) * std::size_t(width_) + std::size_t(x0)) * c));
+            }
+    return out;
+}
+
+void FilmLayer::assign(std::span<const float> values) {
+    const auto c = std::size_t(channels);
+    if (values.size() != std::size_t(width_) * std::size_t(height_) * c)
+        throw std::invalid_argument(strCat("FilmLayer '", name, "': ", values.size(),
+                                           " values for ", width_, " x ", height_, " x ", c));
+    for (int y = 0; y < height_; ++y)
+        for (int tx = 0; tx < tilesX_; ++tx) {
+            const int x0 = tx * kTileSize, n = std::min(kTileSize, width_ - x0);
+            const auto row = values.subspan(
+                (std::size_t(y) * std::size_t(width_) + std::size_t(x0)) * c, std::size_t(n) * c);
+            // A tile only for what is not zero: what a tile left out reads as.
+            if (!tileOrNull(tx, y / kTileSize) &&
+                std::all_of(row.begin(), row.end(), [](float v) { return isPositiveZero(v); }))
+                continue;
+            std::copy(row.begin(), row.end(), tile(tx, y / kTileSize) + offset(x0, y));
+        }
+}
 
 Film::Film(int width, int height)
     : width_(width)
@@ -12,22 +74,13 @@ Film::Film(int width, int height)
         throw std::invalid_argument(strCat("Film: size ", width, " x ", height));
 }
 
-std::size_t Film::addLayer(std::string name, int channels, bool fullPrecision, Init init) {
+std::size_t Film::addLayer(std::string name, int channels, bool fullPrecision) {
     if (channels != 1 && channels != 3)
         throw std::invalid_argument(
             strCat("Film: layer '", name, "' with ", channels, " channels"));
     if (find(name))
         throw std::invalid_argument(strCat("Film: layer '", name, "' added twice"));
-    FilmLayer l;
-    l.name = std::move(name);
-    l.channels = channels;
-    l.fullPrecision = fullPrecision;
-    const std::size_t size = pixelCount() * std::size_t(channels);
-    if (init == Init::Zero)
-        l.data.assign(size, 0.0f);
-    else
-        l.data.resize(size); // NaN in the sanitizer builds (core/large_array.h)
-    layers_.push_back(std::move(l));
+    layers_.emplace_back(std::move(name), channels, fullPrecision, width_, height_);
     return layers_.size() - 1;
 }
 
@@ -47,6 +100,20 @@ const FilmLayer& Film::layer(std::string_view name) const {
 
 FilmLayer& Film::layer(std::string_view name) {
     return const_cast<FilmLayer&>(static_cast<const Film&>(*this).layer(name));
+}
+
+std::size_t Film::bytesHeld() const {
+    std::size_t bytes = 0;
+    for (const FilmLayer& l : layers_)
+        bytes += l.bytesHeld();
+    return bytes;
+}
+
+std::size_t Film::denseBytes() const {
+    std::size_t bytes = 0;
+    for (const FilmLayer& l : layers_)
+        bytes += pixelCount() * std::size_t(l.channels) * sizeof(float);
+    return bytes;
 }
 
 std::ostream& operator<<(std::ostream& os, const Film& film) {

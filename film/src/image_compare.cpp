@@ -17,8 +17,7 @@ ComparedImage ComparedImage::fromFilm(const Film& film, const std::vector<std::s
         for (std::size_t p = 0; p < film.pixelCount(); ++p)
             image.value[p] += layer.rgb(p);
     }
-    const auto& mask = film.layer(maskLayer).data;
-    image.mask.assign(mask.begin(), mask.end());
+    image.mask = film.layer(maskLayer).dense();
     if (!halfLayer.empty()) {
         const FilmLayer& h = film.layer(halfLayer);
         image.halfA.resize(film.pixelCount());

@@ -289,12 +289,11 @@ void restoreSums(const Film& film, std::uint32_t spp, std::vector<PixelSums>& su
         for (const LayerSlot& l : kLayers) {
             const FilmLayer& layer = film.layer(l.name);
             for (int c = 0; c < l.channels; ++c)
-                s.sum[l.slot + std::size_t(c)] =
-                    n * double(layer.data[p * std::size_t(l.channels) + std::size_t(c)]);
+                s.sum[l.slot + std::size_t(c)] = n * double(layer.value(p, c));
         }
         for (std::size_t c = 0; c < 3; ++c) {
-            s.beautyA[c] = nA * double(half.data[3 * p + c]);
-            s.hairA[c] = nA * double(hairHalf.data[3 * p + c]);
+            s.beautyA[c] = nA * double(half.value(p, int(c)));
+            s.hairA[c] = nA * double(hairHalf.value(p, int(c)));
         }
     }
 }
@@ -318,11 +317,11 @@ Film filmOf(int width, int height, const std::vector<PixelSums>& sums, std::uint
         for (std::size_t i = 0; i < kLayers.size(); ++i) {
             const auto channels = static_cast<std::size_t>(kLayers[i].channels);
             for (std::size_t c = 0; c < channels; ++c)
-                layers[i]->data[p * channels + c] = static_cast<float>(s.sum[kLayers[i].slot + c] / n);
+                layers[i]->at(p, int(c)) = static_cast<float>(s.sum[kLayers[i].slot + c] / n);
         }
         for (std::size_t c = 0; c < 3; ++c) {
-            half.data[3 * p + c] = static_cast<float>(s.beautyA[c] / nA);
-            hairHalf.data[3 * p + c] = static_cast<float>(s.hairA[c] / nA);
+            half.at(p, int(c)) = static_cast<float>(s.beautyA[c] / nA);
+            hairHalf.at(p, int(c)) = static_cast<float>(s.hairA[c] / nA);
         }
     }
     return film;

@@ -76,8 +76,13 @@ bool filmShowsHair(const Film& film) {
     const auto hair = film.find(kHairAlphaLayer);
     if (!hair || film.pixelCount() == 0)
         return true;
-    const auto& a = film.layer(*hair).data;
-    return std::any_of(a.begin(), a.end(), [](float x) { return x > 0; });
+    const FilmLayer& a = film.layer(*hair);
+    for (int ty = 0; ty < a.tilesY(); ++ty)
+        for (int tx = 0; tx < a.tilesX(); ++tx)
+            if (const float* t = a.tileOrNull(tx, ty);
+                t && std::any_of(t, t + FilmLayer::kTilePixels, [](float x) { return x > 0; }))
+                return true;
+    return false;
 }
 
 /// A warning when no pixel of the rendered image covers hair.
@@ -833,6 +838,11 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
             " segments outside the view, " + thousands(st.segmentTilesBehindSurfaces) +
             " segment-tiles behind surfaces, " + thousands(st.segmentTilesSkipped) +
             " segment-tiles opaque");
+    const auto megabytes = [](std::size_t bytes) {
+        return (bytes + 500'000) / 1'000'000;
+    };
+    more(strCat("film: ", megabytes(r.film.bytesHeld()), " of ", megabytes(r.film.denseBytes()),
+                " MB held (a layer holds no ", Film::kTileSize, "-pixel tile that is all zero)"));
     const std::string rate =
         scene.shadingRate == ShadingRate::Adaptive
             ? strCat("adaptive rate, tolerance ", scene.shadingTolerance, ": ",

@@ -27,7 +27,8 @@ using raster::ScreenRibbon;
 using raster::Vec2d;
 using Clock = std::chrono::steady_clock;
 
-constexpr int kTileSize = 32;
+/// The film's tiles: a tile of the raster writes one tile of each layer.
+constexpr int kTileSize = Film::kTileSize;
 constexpr std::uint32_t kSurfaceFragment = std::numeric_limits<std::uint32_t>::max();
 /// A film layer RasterSettings::layers leaves out.
 constexpr std::size_t kNotStored = std::numeric_limits<std::size_t>::max();
@@ -145,9 +146,9 @@ struct RenderContext {
     std::size_t beautyLayer = 0, alphaLayer = 0, surfaceLayer = 0, backgroundLayer = 0,
                 hairAlphaLayer = 0, depthLayer = 0;
 
-    /// The layer's values, or null where it is not stored.
-    float* values(std::size_t layer) const {
-        return layer == kNotStored ? nullptr : film->layer(layer).data.data();
+    /// The layer, or null where it is not stored.
+    FilmLayer* layer(std::size_t index) const {
+        return index == kNotStored ? nullptr : &film->layer(index);
     }
 
     RenderContext(const Groom& g, const Camera& c, const FragmentShader& sh,
@@ -336,6 +337,42 @@ struct PixelState {
     Rgb surface{0.0f};
 };
 
+/// One tile of a film layer as a raster tile writes it: the film holds the
+/// tile only once a value other than +0 is written (what a tile it does not
+/// hold reads as), so hair layers take no memory where no hair is seen.
+class TileOutput {
+public:
+    TileOutput(FilmLayer* layer, int tx, int ty)
+        : layer_(layer)
+        , tx_(tx)
+        , ty_(ty)
+        , channels_(layer ? std::size_t(layer->channels) : 0) {}
+
+    /// Sets channel c of the pixel at `pixel` (its index in the film's tile),
+    /// which nothing has written yet; nothing where the layer is not stored.
+    void set(std::size_t pixel, std::size_t c, float v) {
+        if (layer_ && !isPositiveZero(v))
+            values()[pixel * channels_ + c] = v;
+    }
+    /// Adds v to channel c of the pixel at `pixel`.
+    void add(std::size_t pixel, std::size_t c, float v) {
+        if (layer_ && !isPositiveZero(v))
+            values()[pixel * channels_ + c] += v;
+    }
+
+private:
+    float* values() {
+        if (!values_)
+            values_ = layer_->tile(tx_, ty_);
+        return values_;
+    }
+
+    FilmLayer* layer_;
+    int tx_, ty_;
+    std::size_t channels_;
+    float* values_ = nullptr;
+};
+
 struct TileScratch {
     std::vector<ScreenRibbon> ribbons;   ///< per local segment
     std::vector<float> zMin;             ///< per local segment: its nearest depth
@@ -361,6 +398,7 @@ struct TileScratch {
     std::vector<std::uint32_t> probeOf;  ///< per local segment: its smooth probe, or none
     std::vector<float> pixelSum;         ///< per pixel: stride floats of weighted sums
     raster::CoverageCells coverageCells; ///< rasterizeRibbon's, all 0 between ribbons
+    std::vector<TileOutput> radianceOutputs, averageOutputs; ///< finishShading()'s
 };
 
 struct TileResult {
@@ -429,11 +467,11 @@ public:
     TileRenderer(const RenderContext& ctx, TileScratch& s, int tile)
         : ctx_(ctx)
         , s_(s)
-        , film_(*ctx.film)
         , stride_(ctx.stride) {
-        const int tx = tile % ctx.tilesX, ty = tile / ctx.tilesX;
-        x0_ = tx * kTileSize;
-        y0_ = ty * kTileSize;
+        tx_ = tile % ctx.tilesX;
+        ty_ = tile / ctx.tilesX;
+        x0_ = tx_ * kTileSize;
+        y0_ = ty_ * kTileSize;
         x1_ = std::min(ctx.camera.width(), x0_ + kTileSize);
         y1_ = std::min(ctx.camera.height(), y0_ + kTileSize);
         width_ = x1_ - x0_;
@@ -463,10 +501,18 @@ public:
     }
 
 private:
-    std::size_t filmIndex(std::uint32_t pixel) const {
-        return film_.index(x0_ + int(pixel % std::uint32_t(width_)),
-                           y0_ + int(pixel / std::uint32_t(width_)));
+    /// The index of a pixel of the tile in the surface layer (row-major).
+    std::size_t imageIndex(std::uint32_t pixel) const {
+        return std::size_t(y0_ + int(pixel / std::uint32_t(width_))) *
+                   std::size_t(ctx_.camera.width()) +
+               std::size_t(x0_ + int(pixel % std::uint32_t(width_)));
     }
+    /// Its index in the film's tile, which is kTileSize wide at the image's edge too.
+    std::size_t tileIndex(std::uint32_t pixel) const {
+        return std::size_t(pixel / std::uint32_t(width_)) * kTileSize +
+               std::size_t(pixel % std::uint32_t(width_));
+    }
+    TileOutput output(std::size_t layer) const { return {ctx_.layer(layer), tx_, ty_}; }
     std::uint32_t pixelIndex(int x, int y) const {
         return static_cast<std::uint32_t>((y - y0_) * width_ + (x - x0_));
     }
@@ -510,7 +556,8 @@ private:
             return;
         for (int y = y0_; y < y1_; ++y)
             for (int x = x0_; x < x1_; ++x) {
-                const std::size_t i = film_.index(x, y);
+                const std::size_t i =
+                    std::size_t(y) * std::size_t(ctx_.camera.width()) + std::size_t(x);
                 if (ctx_.surfaces.coverage[i] > 0)
                     s_.pending.push_back({ctx_.surfaces.depth[i], ctx_.surfaces.coverage[i], 0,
                                           kSurfaceFragment, pixelIndex(x, y)});
@@ -659,7 +706,7 @@ private:
             st.hairWeight += w;
             ++result_.composited;
         } else {
-            st.surface += w * ctx_.surfaces.radiance[filmIndex(f.pixel)];
+            st.surface += w * ctx_.surfaces.radiance[imageIndex(f.pixel)];
         }
         if (st.T <= ctx_.settings.opaqueTransmittance) {
             st.closed = true;
@@ -670,28 +717,21 @@ private:
     }
 
     void finishCoverage() {
-        float* alpha = ctx_.values(ctx_.alphaLayer);
-        float* hairAlpha = ctx_.values(ctx_.hairAlphaLayer);
-        float* depth = ctx_.values(ctx_.depthLayer);
-        float* surface = ctx_.values(ctx_.surfaceLayer);
-        float* background = ctx_.values(ctx_.backgroundLayer);
-        float* beauty = ctx_.values(ctx_.beautyLayer);
+        TileOutput alpha = output(ctx_.alphaLayer), hairAlpha = output(ctx_.hairAlphaLayer),
+                   depth = output(ctx_.depthLayer), surface = output(ctx_.surfaceLayer),
+                   background = output(ctx_.backgroundLayer), beauty = output(ctx_.beautyLayer);
         for (std::uint32_t p = 0; p < area_; ++p) {
             const PixelState& st = s_.pixels[p];
-            const std::size_t i = filmIndex(p);
-            alpha[i] = 1.0f - st.T;
-            if (hairAlpha)
-                hairAlpha[i] = st.hairWeight;
-            if (depth)
-                depth[i] = st.T < 1.0f ? st.depthSum / (1.0f - st.T) : 0.0f;
+            const std::size_t i = tileIndex(p);
+            alpha.set(i, 0, 1.0f - st.T);
+            hairAlpha.set(i, 0, st.hairWeight);
+            depth.set(i, 0, st.T < 1.0f ? st.depthSum / (1.0f - st.T) : 0.0f);
             const Rgb b = st.T * ctx_.settings.background;
             for (int c = 0; c < 3; ++c) {
-                const std::size_t k = 3 * i + std::size_t(c);
-                if (surface)
-                    surface[k] = st.surface[c];
-                if (background)
-                    background[k] = b[c];
-                beauty[k] = st.surface[c] + b[c];
+                const auto k = std::size_t(c);
+                surface.set(i, k, st.surface[c]);
+                background.set(i, k, b[c]);
+                beauty.set(i, k, st.surface[c] + b[c]);
             }
         }
     }
@@ -951,30 +991,32 @@ private:
 
     /// Radiance layers get the premultiplied sums (and add to the beauty);
     /// average layers the sums divided by the hair's weight, 0 without hair.
-    /// Every pixel of the tile is written: the shader's layers are allocated
-    /// uninitialised (Film::Init::Uninitialized).
     void finishShading() {
-        float* beauty = ctx_.values(ctx_.beautyLayer);
+        TileOutput beauty = output(ctx_.beautyLayer);
+        std::vector<TileOutput>& radiance = s_.radianceOutputs;
+        std::vector<TileOutput>& average = s_.averageOutputs;
+        radiance.clear();
+        average.clear();
+        for (std::size_t layer : ctx_.radianceLayer)
+            radiance.push_back(output(layer));
+        for (std::size_t layer : ctx_.averageLayer)
+            average.push_back(output(layer));
         for (std::uint32_t p = 0; p < area_; ++p) {
             const float w = s_.pixels[p].hairWeight;
-            const std::size_t i = filmIndex(p);
+            const std::size_t i = tileIndex(p);
             // Zero where no fragment was shaded: nothing accumulated.
             const float* sum = s_.pixelSum.data() + std::size_t(p) * stride_;
-            for (std::size_t l = 0; l < ctx_.radianceLayer.size(); ++l) {
-                float* layer = ctx_.values(ctx_.radianceLayer[l]);
+            for (std::size_t l = 0; l < radiance.size(); ++l)
                 for (std::size_t c = 0; c < 3; ++c) {
-                    if (layer)
-                        layer[3 * i + c] = sum[3 * l + c];
-                    beauty[3 * i + c] += sum[3 * l + c];
+                    radiance[l].set(i, c, sum[3 * l + c]);
+                    beauty.add(i, c, sum[3 * l + c]);
                 }
-            }
             const float invW = w > 0 ? 1.0f / w : 0.0f;
             std::size_t k = ctx_.radianceFloats;
-            for (std::size_t l = 0; l < ctx_.averageLayer.size(); ++l) {
+            for (std::size_t l = 0; l < average.size(); ++l) {
                 const auto channels = static_cast<std::size_t>(ctx_.layout.averages[l].channels);
-                if (float* layer = ctx_.values(ctx_.averageLayer[l]))
-                    for (std::size_t c = 0; c < channels; ++c)
-                        layer[channels * i + c] = sum[k + c] * invW;
+                for (std::size_t c = 0; c < channels; ++c)
+                    average[l].set(i, c, sum[k + c] * invW);
                 k += channels;
             }
         }
@@ -982,9 +1024,8 @@ private:
 
     const RenderContext& ctx_;
     TileScratch& s_;
-    Film& film_;
     std::size_t stride_;
-    int x0_, y0_, x1_, y1_, width_;
+    int tx_, ty_, x0_, y0_, x1_, y1_, width_;
     std::uint32_t area_;
     std::span<const std::uint32_t> bins_;
     std::size_t openPixels_ = 0;
@@ -1061,11 +1102,10 @@ RasterOutput rasterize(const Groom& groom, const Camera& camera, const FragmentS
     RasterOutput out;
     out.film = Film(camera.width(), camera.height());
     Film& film = out.film;
-    // Every layer's pixels are written by their tile (finishCoverage(),
-    // finishShading()), so the film's pages are first touched there.
-    constexpr Film::Init tileWritten = Film::Init::Uninitialized;
-    ctx.beautyLayer = film.addLayer(std::string(Film::kBeauty), 3, false, tileWritten);
-    ctx.alphaLayer = film.addLayer(std::string(Film::kAlpha), 1, false, tileWritten);
+    // Each layer's tiles are allocated by the raster tile that writes them
+    // (finishCoverage(), finishShading()), where it writes anything but +0.
+    ctx.beautyLayer = film.addLayer(std::string(Film::kBeauty), 3);
+    ctx.alphaLayer = film.addLayer(std::string(Film::kAlpha), 1);
     const std::vector<RasterLayer> layers = rasterLayers(ctx.layout);
     if (settings.layers)
         for (const std::string& name : *settings.layers)
@@ -1074,9 +1114,8 @@ RasterOutput rasterize(const Groom& groom, const Camera& camera, const FragmentS
                 throw InputError(strCat("layer \"", name, "\": not a layer of this render"));
     std::vector<std::size_t> index;
     for (const RasterLayer& l : layers)
-        index.push_back(settings.stores(l.name)
-                            ? film.addLayer(l.name, l.channels, l.fullPrecision, tileWritten)
-                            : kNotStored);
+        index.push_back(settings.stores(l.name) ? film.addLayer(l.name, l.channels, l.fullPrecision)
+                                                : kNotStored);
     // rasterLayers()' order: radiance, the rasterizer's four, averages.
     const std::size_t radiance = ctx.layout.radiance.size();
     ctx.radianceLayer.assign(index.begin(), index.begin() + std::ptrdiff_t(radiance));

@@ -11,8 +11,9 @@ namespace hairvox::test {
 inline std::vector<unsigned char> filmBytes(const Film& film) {
     std::vector<unsigned char> bytes;
     for (const FilmLayer& layer : film.layers()) {
-        const auto* p = reinterpret_cast<const unsigned char*>(layer.data.data());
-        bytes.insert(bytes.end(), p, p + layer.data.size() * sizeof(float));
+        const std::vector<float> values = layer.dense();
+        const auto* p = reinterpret_cast<const unsigned char*>(values.data());
+        bytes.insert(bytes.end(), p, p + values.size() * sizeof(float));
     }
     return bytes;
 }

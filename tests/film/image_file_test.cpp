@@ -35,32 +35,103 @@ Film randomFilm(int width, int height, std::uint64_t seed) {
           std::tuple{std::string("direct_R"), 3, false}, std::tuple{std::string("key.V"), 1, false},
           std::tuple{std::string("Z"), 1, true}}) {
         FilmLayer& layer = film.layer(film.addLayer(name, channels, full));
-        for (float& x : layer.data)
+        std::vector<float> values(film.pixelCount() * std::size_t(channels));
+        for (float& x : values)
             x = full ? 1.0f + rng.uniformFloat() : rng.uniformFloat();
+        layer.assign(values);
     }
     return film;
 }
 
-TEST(Film, LayersAreNamedOnceAndSized) {
+TEST(Film, LayersAreNamedOnce) {
     Film film(4, 3);
     EXPECT_EQ(film.addLayer("x", 3), 0u);
     EXPECT_EQ(film.addLayer("y", 1), 1u);
-    EXPECT_EQ(film.layer("x").data.size(), 36u);
-    EXPECT_EQ(film.layer("y").data.size(), 12u);
+    EXPECT_EQ(film.layer("x").dense().size(), 36u);
+    EXPECT_EQ(film.layer("y").dense().size(), 12u);
     EXPECT_THROW(film.addLayer("x", 1), std::invalid_argument);
     EXPECT_THROW(film.addLayer("z", 2), std::invalid_argument);
     EXPECT_THROW(static_cast<void>(film.layer("missing")), std::out_of_range);
     EXPECT_FALSE(film.find("missing"));
-    // A layer its producer fills: sized, zero only if asked; NaN where the
-    // sanitizer builds poison it, so that a pixel left unwritten shows.
-    const std::size_t u = film.addLayer("u", 3, false, Film::Init::Uninitialized);
-    EXPECT_EQ(film.layer(u).data.size(), 36u);
-#ifdef HAIRVOX_POISON_UNINITIALIZED
-    for (float x : film.layer(u).data)
-        EXPECT_TRUE(std::isnan(x));
-#endif
-    for (float x : film.layer("x").data)
-        EXPECT_EQ(x, 0.0f);
+}
+
+TEST(Film, HoldsOnlyTheTilesWrittenAndReadsZeroElsewhere) {
+    // 70 × 40 pixels: 3 × 2 tiles, the last column and row partial.
+    Film film(70, 40);
+    FilmLayer& layer = film.layer(film.addLayer("x", 3));
+    EXPECT_EQ(layer.tilesX(), 3);
+    EXPECT_EQ(layer.tilesY(), 2);
+    EXPECT_EQ(layer.tilesHeld(), 0u);
+    EXPECT_EQ(film.bytesHeld(), 0u);
+    EXPECT_EQ(film.denseBytes(), 70u * 40u * 3u * sizeof(float));
+    EXPECT_EQ(layer.value(69, 39, 2), 0.0f);
+    EXPECT_EQ(layer.rgb(film.index(69, 39)), Rgb(0.0f));
+    EXPECT_EQ(layer.dense(), std::vector<float>(70 * 40 * 3, 0.0f));
+
+    layer.at(69, 39, 2) = 5.0f;
+    EXPECT_EQ(layer.tilesHeld(), 1u);
+    EXPECT_NE(layer.tileOrNull(2, 1), nullptr);
+    EXPECT_EQ(layer.tileOrNull(0, 0), nullptr);
+    EXPECT_EQ(layer.value(69, 39, 2), 5.0f);
+    EXPECT_EQ(layer.value(film.index(69, 39), 2), 5.0f);
+    EXPECT_EQ(layer.value(68, 39, 2), 0.0f);
+    EXPECT_EQ(layer.dense()[film.index(69, 39) * 3 + 2], 5.0f);
+    EXPECT_EQ(film.bytesHeld(), FilmLayer::kTilePixels * 3 * sizeof(float));
+
+    // assign() holds the tiles with anything but +0 (−0 is kept), and
+    // dense() gives back what it was given.
+    std::vector<float> values(70 * 40 * 3, 0.0f);
+    values[film.index(40, 5) * 3] = 1.0f;      // tile (1, 0)
+    values[film.index(3, 35) * 3 + 1] = -0.0f; // tile (0, 1)
+    Film other(70, 40);
+    FilmLayer& assigned = other.layer(other.addLayer("y", 3));
+    assigned.assign(values);
+    EXPECT_EQ(assigned.tilesHeld(), 2u);
+    EXPECT_NE(assigned.tileOrNull(1, 0), nullptr);
+    EXPECT_NE(assigned.tileOrNull(0, 1), nullptr);
+    const std::vector<float> back = assigned.dense();
+    ASSERT_EQ(back.size(), values.size());
+    for (std::size_t i = 0; i < values.size(); ++i)
+        ASSERT_EQ(std::bit_cast<std::uint32_t>(back[i]), std::bit_cast<std::uint32_t>(values[i]))
+            << i;
+    EXPECT_THROW(assigned.assign(std::vector<float>(5)), std::invalid_argument);
+}
+
+TEST(ExrFile, TilesNotHeldWriteAsZeros) {
+    // The same image, once with its zero tiles left out and once with every
+    // tile held: the same file, byte for byte, at every compression.
+    Film sparse(70, 40), dense(70, 40);
+    for (Film* film : {&sparse, &dense}) {
+        film->addLayer(std::string(Film::kBeauty), 3);
+        film->addLayer("Z", 1, true);
+        FilmLayer& beauty = film->layer(Film::kBeauty);
+        beauty.at(40, 5, 0) = 0.5f;
+        beauty.at(3, 35, 1) = -0.0f;
+        film->layer("Z").at(69, 39) = 2.0f;
+    }
+    for (FilmLayer* l : {&dense.layer(Film::kBeauty), &dense.layer("Z")})
+        for (int ty = 0; ty < l->tilesY(); ++ty)
+            for (int tx = 0; tx < l->tilesX(); ++tx)
+                l->tile(tx, ty);
+    EXPECT_EQ(sparse.layer(Film::kBeauty).tilesHeld(), 2u);
+    EXPECT_EQ(dense.layer(Film::kBeauty).tilesHeld(), 6u);
+    test::TempDir dir;
+    const auto bytes = [](const std::filesystem::path& path) {
+        std::ifstream in(path, std::ios::binary);
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    };
+    for (const auto& [compression, name] : kExrCompressionNames.entries) {
+        ExrHeader header;
+        header.compression = compression;
+        writeExr(dir / "sparse.exr", sparse, header);
+        writeExr(dir / "dense.exr", dense, header);
+        EXPECT_EQ(bytes(dir / "sparse.exr"), bytes(dir / "dense.exr")) << name;
+    }
+    const ExrImage exr = readExr(dir / "sparse.exr");
+    EXPECT_EQ(exr.channels.at("R")[sparse.index(40, 5)], 0.5f);
+    EXPECT_TRUE(std::signbit(exr.channels.at("G")[sparse.index(3, 35)]));
+    EXPECT_EQ(exr.channels.at("Z")[sparse.index(69, 39)], 2.0f);
+    EXPECT_EQ(exr.channels.at("Z")[sparse.index(0, 0)], 0.0f);
 }
 
 TEST(ExrFile, EveryLayerRoundTripsAtItsPrecision) {
@@ -109,8 +180,10 @@ TEST(ExrFile, ZipLevelTradesSizeAndIsChecked) {
     // A smooth image (as renders are), taller than one band of rows.
     Film film(300, 600);
     FilmLayer& beauty = film.layer(film.addLayer(std::string(Film::kBeauty), 3));
-    for (std::size_t i = 0; i < beauty.data.size(); ++i)
-        beauty.data[i] = 0.5f + 0.4f * std::sin(0.001f * float(i));
+    std::vector<float> values(3 * film.pixelCount());
+    for (std::size_t i = 0; i < values.size(); ++i)
+        values[i] = 0.5f + 0.4f * std::sin(0.001f * float(i));
+    beauty.assign(values);
     test::TempDir dir;
     std::uintmax_t size[10] = {};
     for (const int level : {1, 9}) {
@@ -123,7 +196,7 @@ TEST(ExrFile, ZipLevelTradesSizeAndIsChecked) {
         ASSERT_EQ(g.size(), film.pixelCount());
         float worst = 0; // lossless up to half's rounding, at any level
         for (std::size_t p = 0; p < g.size(); ++p)
-            worst = std::max(worst, std::abs(g[p] - beauty.data[3 * p + 1]));
+            worst = std::max(worst, std::abs(g[p] - values[3 * p + 1]));
         EXPECT_LT(worst, 1e-3f) << level;
     }
     EXPECT_LE(size[9], size[1]);
@@ -136,9 +209,10 @@ TEST(ExrFile, ZipLevelTradesSizeAndIsChecked) {
 TEST(ExrFile, EveryCompressionIsLosslessAndTradesSize) {
     // A render-like image: smooth hair over a flat background.
     Film film(300, 600);
-    FilmLayer& beauty = film.layer(film.addLayer(std::string(Film::kBeauty), 3));
-    for (std::size_t i = 0; i < beauty.data.size(); ++i)
-        beauty.data[i] = (i / 3) % 300 < 150 ? 0.02f : 0.5f + 0.4f * std::sin(0.001f * float(i));
+    std::vector<float> values(3 * film.pixelCount());
+    for (std::size_t i = 0; i < values.size(); ++i)
+        values[i] = (i / 3) % 300 < 150 ? 0.02f : 0.5f + 0.4f * std::sin(0.001f * float(i));
+    film.layer(film.addLayer(std::string(Film::kBeauty), 3)).assign(values);
     test::TempDir dir;
     std::map<ExrCompression, std::uintmax_t> size;
     std::vector<float> first;
@@ -164,8 +238,10 @@ TEST(ExrFile, NamesLongerThan31CharactersRoundTrip) {
     Film film(5, 4);
     const std::string name = "a_rim_light_named_at_some_length.T_s";
     FilmLayer& layer = film.layer(film.addLayer(name, 3));
-    for (std::size_t i = 0; i < layer.data.size(); ++i)
-        layer.data[i] = 0.25f * float(i % 7);
+    std::vector<float> values(3 * film.pixelCount());
+    for (std::size_t i = 0; i < values.size(); ++i)
+        values[i] = 0.25f * float(i % 7);
+    layer.assign(values);
     test::TempDir dir;
     ExrHeader header;
     header.attributes = {{"hairvox:an_attribute_named_past_31_chars", "x"}};
@@ -179,7 +255,7 @@ TEST(ExrFile, NamesLongerThan31CharactersRoundTrip) {
 TEST(ExrFile, KeepsValuesBeyondHalfRange) {
     Film film(4, 2);
     film.addLayer(std::string(Film::kBeauty), 3);
-    film.layer(Film::kBeauty).data[9] = 1e6f;
+    film.layer(Film::kBeauty).at(3, 0) = 1e6f;
     test::TempDir dir;
     writeExr(dir / "bright.exr", film);
     const ExrImage exr = readExr(dir / "bright.exr");
@@ -209,22 +285,25 @@ TEST(ExrFile, HalvesRoundAsImathDoesOnEveryCpu) {
             const float x = std::ldexp(1.0f + rng.uniformFloat(), int(rng.uniformFloat() * 46.0f) - 30);
             return rng.uniformFloat() < 0.5f ? -x : x;
         };
-        for (std::size_t i = 0; i < rgb.data.size(); ++i)
-            rgb.data[i] = value(i);
-        for (std::size_t i = 0; i < scalar.data.size(); ++i)
-            scalar.data[i] = value(i);
+        std::vector<float> rgbValues(3 * film.pixelCount()), scalarValues(film.pixelCount());
+        for (std::size_t i = 0; i < rgbValues.size(); ++i)
+            rgbValues[i] = value(i);
+        for (std::size_t i = 0; i < scalarValues.size(); ++i)
+            scalarValues[i] = value(i);
+        rgb.assign(rgbValues);
+        scalar.assign(scalarValues);
         test::TempDir dir;
         writeExr(dir / "halves.exr", film);
         const ExrImage exr = readExr(dir / "halves.exr");
         const char* names[3] = {"direct_R.R", "direct_R.G", "direct_R.B"};
         for (std::size_t p = 0; p < film.pixelCount(); ++p) {
             for (std::size_t c = 0; c < 3; ++c) {
-                const float x = rgb.data[3 * p + c];
+                const float x = rgbValues[3 * p + c];
                 ASSERT_EQ(std::bit_cast<std::uint32_t>(exr.channels.at(names[c])[p]),
                           std::bit_cast<std::uint32_t>(float(Imath::half(x))))
                     << "pixel " << p << " channel " << c << " value " << x;
             }
-            const float x = scalar.data[p];
+            const float x = scalarValues[p];
             ASSERT_EQ(std::bit_cast<std::uint32_t>(exr.channels.at("key.V")[p]),
                       std::bit_cast<std::uint32_t>(float(Imath::half(x))))
                 << "pixel " << p << " value " << x;
@@ -254,7 +333,7 @@ TEST(PngFile, ToneMapsAreMonotoneAndDocumented) {
     const float values[5] = {0.0f, 0.0031308f, 0.18f, 1.0f, 100.0f};
     for (std::size_t i = 0; i < 5; ++i)
         for (std::size_t c = 0; c < 3; ++c)
-            film.layer(Film::kBeauty).data[3 * i + c] = values[i];
+            film.layer(Film::kBeauty).at(i, int(c)) = values[i];
     const std::vector<std::uint8_t> clamp = previewPixels(film, 0.0f, ToneMap::Clamp);
     EXPECT_EQ(clamp[0], 0);
     EXPECT_EQ(clamp[3], 10);  // 12.92 · 0.0031308 · 255 = 10.3

@@ -28,14 +28,14 @@ double sum(std::span<const float> v) {
                            [](double a, float b) { return a + double(b); });
 }
 
-const LargeVector<float>& alpha(const Film& f) {
-    return f.layer(Film::kAlpha).data;
+std::vector<float> alpha(const Film& f) {
+    return f.layer(Film::kAlpha).dense();
 }
-const LargeVector<float>& hairAlpha(const Film& f) {
-    return f.layer(kHairAlphaLayer).data;
+std::vector<float> hairAlpha(const Film& f) {
+    return f.layer(kHairAlphaLayer).dense();
 }
-const LargeVector<float>& depth(const Film& f) {
-    return f.layer(kDepthLayer).data;
+std::vector<float> depth(const Film& f) {
+    return f.layer(kDepthLayer).dense();
 }
 Rgb rgb(const Film& f, std::string_view layer, std::size_t p) {
     return f.layer(layer).rgb(p);

@@ -6,39 +6,122 @@
 // has channels direct_R.R, direct_R.G, direct_R.B; a scalar layer's name is its
 // channel's name ("A", "Z", "hair.A", "key.V"). What each layer means is the
 // integrator's (render/ and pathtrace/ document theirs); the film only stores
-// them. Storage is interleaved per layer (RGB RGB ...), row-major, row 0 at
-// the top (geometry/camera.h).
+// them. Row 0 is at the top (geometry/camera.h).
+//
+// Storage is sparse, in tiles of kTileSize² pixels (the rasterizer's tiles):
+// a layer holds a tile only once something is written into it, and a tile it
+// does not hold reads as zeros. Most AOVs are zero wherever no hair is seen —
+// on the 1080p head, 80% of the tiles of every hair layer — and a film of
+// dense layers was most of a render's memory (357 of the head's 679 MiB),
+// every byte of it paid at its first touch (docs/DESIGN.md §7, "A sparse
+// film"). Within a tile, pixels are row-major and a pixel's channels
+// interleaved (RGB RGB ...); a tile at the image's right or bottom edge has
+// the full size, its pixels outside the image zero.
 #pragma once
 
-#include <hairvox/core/large_array.h>
 #include <hairvox/core/rgb.h>
 
+#include <bit>
 #include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <memory>
 #include <optional>
 #include <ostream>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
 namespace hairvox {
 
-struct FilmLayer {
+/// Whether v is what a tile a layer does not hold reads as: +0 (−0 and NaN
+/// are values to keep).
+inline bool isPositiveZero(float v) {
+    return std::bit_cast<std::uint32_t>(v) == 0;
+}
+
+class FilmLayer {
+public:
+    /// Pixels on a side of a tile.
+    static constexpr int kTileSize = 32;
+    static constexpr std::size_t kTilePixels = std::size_t(kTileSize) * kTileSize;
+
+    FilmLayer(std::string name, int channels, bool fullPrecision, int width, int height);
+
     std::string name;
     int channels = 3; ///< 1 or 3
     /// Stored as 32-bit float in files even where half would hold the values
     /// (depth: half's 11-bit mantissa is too coarse).
     bool fullPrecision = false;
-    LargeVector<float> data; ///< pixelCount() × channels
 
+    int width() const { return width_; }
+    int height() const { return height_; }
+    int tilesX() const { return tilesX_; }
+    int tilesY() const { return tilesY_; }
+
+    /// Channel c of pixel (x, y); 0 where the tile is not held.
+    float value(int x, int y, int c = 0) const {
+        const float* t = tileOrNull(x / kTileSize, y / kTileSize);
+        return t ? t[offset(x, y) + std::size_t(c)] : 0.0f;
+    }
+    /// Channel c of pixel (x, y), its tile allocated (zeros) if not held.
+    float& at(int x, int y, int c = 0) {
+        return tile(x / kTileSize, y / kTileSize)[offset(x, y) + std::size_t(c)];
+    }
+
+    /// The same by pixel index y · width + x.
+    float value(std::size_t pixel, int c = 0) const { return value(xOf(pixel), yOf(pixel), c); }
+    float& at(std::size_t pixel, int c = 0) { return at(xOf(pixel), yOf(pixel), c); }
     Rgb rgb(std::size_t pixel) const {
-        const float* p = &data[pixel * 3];
+        const int x = xOf(pixel), y = yOf(pixel);
+        const float* t = tileOrNull(x / kTileSize, y / kTileSize);
+        if (!t)
+            return Rgb(0.0f);
+        const float* p = t + offset(x, y);
         return {p[0], p[1], p[2]};
     }
-    float scalar(std::size_t pixel) const { return data[pixel]; }
+    float scalar(std::size_t pixel) const { return value(pixel); }
+
+    /// Tile (tx, ty)'s kTilePixels × channels values, or null if not held.
+    const float* tileOrNull(int tx, int ty) const {
+        return tiles_[std::size_t(ty) * std::size_t(tilesX_) + std::size_t(tx)].get();
+    }
+    /// Tile (tx, ty)'s values, allocated as zeros on the first call. Calls
+    /// for different tiles may run concurrently; calls for one tile may not.
+    float* tile(int tx, int ty);
+    /// Tiles held, of tilesX() · tilesY().
+    std::size_t tilesHeld() const;
+    /// Bytes the held tiles take.
+    std::size_t bytesHeld() const { return tilesHeld() * tileFloats() * sizeof(float); }
+
+    /// Every pixel's channels, row-major: width · height · channels values.
+    std::vector<float> dense() const;
+    /// Sets every pixel from `values` (dense()'s order; size checked).
+    void assign(std::span<const float> values);
+
+private:
+    struct Free {
+        void operator()(float* p) const noexcept { std::free(p); }
+    };
+
+    std::size_t tileFloats() const { return kTilePixels * std::size_t(channels); }
+    int xOf(std::size_t pixel) const { return int(pixel % std::size_t(width_)); }
+    int yOf(std::size_t pixel) const { return int(pixel / std::size_t(width_)); }
+    /// Channel 0 of pixel (x, y) within its tile.
+    std::size_t offset(int x, int y) const {
+        return (std::size_t(y % kTileSize) * kTileSize + std::size_t(x % kTileSize)) *
+               std::size_t(channels);
+    }
+
+    int width_ = 0, height_ = 0, tilesX_ = 0, tilesY_ = 0;
+    std::vector<std::unique_ptr<float[], Free>> tiles_; ///< row-major, null: zeros
 };
 
 class Film {
 public:
+    static constexpr int kTileSize = FilmLayer::kTileSize;
+
     Film() = default;
     Film(int width, int height);
 
@@ -49,21 +132,10 @@ public:
         return std::size_t(y) * std::size_t(width_) + std::size_t(x);
     }
 
-    /// What a new layer holds.
-    enum class Init {
-        Zero,
-        /// Nothing yet: its producer writes every pixel before anything reads
-        /// it, from the threads that render them (core/large_array.h: the
-        /// pages are first touched there, not in a serial memset). Builds
-        /// with HAIRVOX_POISON_UNINITIALIZED (the sanitizer builds) fill it
-        /// with NaN, so that a pixel left unwritten shows in the tests.
-        Uninitialized,
-    };
-
-    /// Adds a layer and returns its index. std::invalid_argument if the name
-    /// is taken or channels is not 1 or 3.
-    std::size_t addLayer(std::string name, int channels, bool fullPrecision = false,
-                         Init init = Init::Zero);
+    /// Adds a layer, zero everywhere and holding no tile, and returns its
+    /// index. std::invalid_argument if the name is taken or channels is not
+    /// 1 or 3.
+    std::size_t addLayer(std::string name, int channels, bool fullPrecision = false);
     std::optional<std::size_t> find(std::string_view name) const;
     /// The named layer; std::out_of_range naming it if absent.
     const FilmLayer& layer(std::string_view name) const;
@@ -74,6 +146,9 @@ public:
 
     /// The beauty layer "" (RGB).
     Rgb beauty(std::size_t pixel) const { return layer(kBeauty).rgb(pixel); }
+    /// Bytes the layers' held tiles take, and what dense layers would.
+    std::size_t bytesHeld() const;
+    std::size_t denseBytes() const;
 
     static constexpr std::string_view kBeauty = "";
     static constexpr std::string_view kAlpha = "A";
