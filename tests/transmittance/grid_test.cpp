@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -202,6 +203,57 @@ TEST(GridGlobalTerm, AQueryDoesNotDependOnItsBatch) {
                     << "query " << i << " channel " << c;
         }
     }
+}
+
+TEST(GridGlobalTerm, LightsSharingAWorkspaceAreThoseOfLightsPreparedAlone) {
+    // A workspace hands one light's rates volume to the next, refilled: every
+    // query of every light must get the bits it gets from a light prepared
+    // alone — cache and march, grid and approx, directional and point lights
+    // (a point light among the fibers: the march), in any order.
+    const test::Slab slab;
+    const FiberGrid grid = splat(slab.groom(), 0.002);
+    std::vector<GlobalTermQuery> queries;
+    Pcg32 rng(13);
+    for (int i = 0; i < 150; ++i)
+        queries.push_back({Vec3f(rng.uniform(-0.01f, 0.01f), rng.uniform(-0.004f, 0.012f),
+                                 rng.uniform(-0.03f, 0.03f)),
+                           Vec3f(1, 0, 0)});
+    const Light lights[] = {Light::directional(glm::normalize(Vec3f(0.2f, 1, 0.1f))),
+                            Light::point(queries[3].position),
+                            Light::directional(glm::normalize(Vec3f(-0.6f, -1, 0.3f))),
+                            Light::point(Vec3f(0.05f, 0.2f, -0.1f))};
+    const auto bits = [](const GlobalTerm& g) {
+        return std::array{
+            std::bit_cast<std::uint32_t>(g.n),         std::bit_cast<std::uint32_t>(g.V),
+            std::bit_cast<std::uint32_t>(g.P.r),       std::bit_cast<std::uint32_t>(g.P.g),
+            std::bit_cast<std::uint32_t>(g.P.b),       std::bit_cast<std::uint32_t>(g.T_s.r),
+            std::bit_cast<std::uint32_t>(g.sigma2_f.b)};
+    };
+    GridOptions march;
+    march.evaluation = GridEvaluation::March;
+    const CrossingTable table = constantTable(0.5f, 0.01f);
+    for (const auto& model : {makeGridModel(grid, {table}, slabSettings(), {}),
+                              makeGridModel(grid, {table}, slabSettings(), march),
+                              makeApproxModel(grid, {table}, slabSettings(), {})}) {
+        const std::unique_ptr<LightWorkspace> workspace = model->makeWorkspace();
+        ASSERT_NE(workspace, nullptr);
+        for (const Light& light : lights) {
+            const auto shared = model->forLight(light, workspace.get());
+            const auto alone = model->forLight(light);
+            std::vector<GlobalTerm> a(queries.size()), b(queries.size());
+            shared->evaluate(queries, a);
+            alone->evaluate(queries, b);
+            for (std::size_t i = 0; i < queries.size(); ++i)
+                ASSERT_EQ(bits(a[i]), bits(b[i]))
+                    << "query " << i << ": " << a[i] << " against " << b[i];
+        }
+    }
+    // A workspace is its model's.
+    const auto one = makeGridModel(grid, {table}, slabSettings(), {});
+    const auto other = makeGridModel(grid, {table}, slabSettings(), {});
+    const std::unique_ptr<LightWorkspace> workspace = one->makeWorkspace();
+    EXPECT_THROW(static_cast<void>(other->forLight(lights[0], workspace.get())),
+                 std::invalid_argument);
 }
 
 TEST(GridGlobalTerm, PoissonKeepsTransmittanceNonNegativeWhereGeometricCannot) {

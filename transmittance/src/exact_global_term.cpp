@@ -56,7 +56,11 @@ public:
         , options(exactOptions) {}
 
     GlobalTermMode mode() const override { return GlobalTermMode::Exact; }
-    std::unique_ptr<LightGlobalTerm> forLight(const Light& light) const override {
+    using GlobalTermModel::forLight;
+    std::unique_ptr<LightGlobalTerm> forLight(const Light& light,
+                                              LightWorkspace* workspace) const override {
+        if (workspace) // makeWorkspace() makes none: another model's
+            throw std::invalid_argument("exact global term: a workspace of another model");
         return withSurfaces(std::make_unique<ExactLightGlobalTerm>(*this, light), settings.surfaces,
                             light);
     }

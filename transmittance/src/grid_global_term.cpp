@@ -111,10 +111,19 @@ public:
         , options_(options) {}
 
     GlobalTermMode mode() const override { return mode_; }
-    std::unique_ptr<LightGlobalTerm> forLight(const Light& light) const override;
+    using GlobalTermModel::forLight;
+    std::unique_ptr<LightGlobalTerm> forLight(const Light& light,
+                                              LightWorkspace* workspace) const override;
+    std::unique_ptr<LightWorkspace> makeWorkspace() const override;
 
-    /// Per-light rates at every active voxel of the fiber grid.
-    BrickVolume buildRates(const Light& light) const;
+    /// A rates volume with a value for every active voxel of the fiber grid
+    /// (and its apron copies), all zero: the same layout for every light.
+    BrickVolume reserveRates() const;
+    /// Sets every active voxel's rates toward `light` in a volume of
+    /// reserveRates()' layout. Every value it sets is set for any light, and
+    /// the others stay zero, so a volume filled for one light is refilled
+    /// for the next as if new.
+    void fillRates(BrickVolume& volume, const Light& light) const;
 
     /// The crossing table of fiber type `type`.
     const CrossingTable& crossings(std::uint8_t type) const { return crossings_.at(type); }
@@ -130,18 +139,35 @@ private:
     GridOptions options_;
 };
 
-BrickVolume GridModel::buildRates(const Light& light) const {
-    using LeafT = openvdb::FloatTree::LeafNodeType;
-    const double h = grid_.info.voxelSize;
-    BrickVolume volume(h);
-    std::vector<const LeafT*> leaves;
-    grid_.density->tree().getNodes(leaves);
-    // The leaves' order is the tree's (deterministic); reserve serially, fill in parallel.
-    const auto brickOf = [](const LeafT& leaf) {
-        const openvdb::Coord o = leaf.origin();
-        return glm::ivec3(o.x(), o.y(), o.z()) / BrickVolume::kBrick; // origins are multiples of 8
-    };
-    for (const LeafT* leaf : leaves) {
+using DensityLeaf = openvdb::FloatTree::LeafNodeType;
+
+/// The brick of a fiber grid leaf (its origin is a multiple of 8).
+glm::ivec3 brickOf(const DensityLeaf& leaf) {
+    const openvdb::Coord o = leaf.origin();
+    return glm::ivec3(o.x(), o.y(), o.z()) / BrickVolume::kBrick;
+}
+
+/// The density grid's leaves, in the tree's (deterministic) order.
+std::vector<const DensityLeaf*> densityLeaves(const FiberGrid& grid) {
+    std::vector<const DensityLeaf*> leaves;
+    grid.density->tree().getNodes(leaves);
+    return leaves;
+}
+
+/// A grid model's LightWorkspace: the rates volume of the last light.
+struct RatesWorkspace final : LightWorkspace {
+    explicit RatesWorkspace(const GridModel& m)
+        : model(&m) {}
+
+    const GridModel* model; ///< the model that made it
+    std::optional<BrickVolume> rates;
+};
+
+BrickVolume GridModel::reserveRates() const {
+    BrickVolume volume(grid_.info.voxelSize);
+    const std::vector<const DensityLeaf*> leaves = densityLeaves(grid_);
+    // Bricks reserved serially (their order is the leaves'), voxels in parallel.
+    for (const DensityLeaf* leaf : leaves) {
         int lowFaces = 0;
         for (auto it = leaf->cbeginValueOn(); it; ++it) {
             const openvdb::Coord l = it.getCoord() - leaf->origin();
@@ -160,6 +186,12 @@ BrickVolume GridModel::buildRates(const Light& light) const {
         }
     });
     volume.allocateValues();
+    return volume;
+}
+
+void GridModel::fillRates(BrickVolume& volume, const Light& light) const {
+    const double h = grid_.info.voxelSize;
+    const std::vector<const DensityLeaf*> leaves = densityLeaves(grid_);
     const float kD = settings_.fiberScale.ribbonWidth();
     const bool tensor = options_.orientation == OrientationModel::Tensor;
     const bool poisson = options_.estimator == AttenuationEstimator::Poisson;
@@ -169,13 +201,13 @@ BrickVolume GridModel::buildRates(const Light& light) const {
     };
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size(), 4), [&](const auto& range) {
         for (std::size_t li = range.begin(); li != range.end(); ++li) {
-            const LeafT& leaf = *leaves[li];
+            const DensityLeaf& leaf = *leaves[li];
             const openvdb::Coord origin = leaf.origin();
             const auto* orientation = grid_.orientation->tree().probeConstLeaf(origin);
             const auto* diag = tensor ? grid_.tensorDiag->tree().probeConstLeaf(origin) : nullptr;
             const auto* offDiag =
                 tensor ? grid_.tensorOffDiag->tree().probeConstLeaf(origin) : nullptr;
-            std::array<const LeafT*, kMaxFiberTypes> fraction{};
+            std::array<const DensityLeaf*, kMaxFiberTypes> fraction{};
             for (std::size_t t = 0; t < grid_.typeFraction.size(); ++t)
                 fraction[t] = grid_.typeFraction[t]->tree().probeConstLeaf(origin);
             const BrickVolume::BrickSet bricks = volume.brickSet(brickOf(leaf));
@@ -206,15 +238,20 @@ BrickVolume GridModel::buildRates(const Light& light) const {
             }
         }
     });
-    return volume;
 }
 
 class GridLightGlobalTerm final : public LightGlobalTerm {
 public:
-    GridLightGlobalTerm(const GridModel& model, const Light& light)
+    /// `workspace`: the rates volume of the light before, refilled for this
+    /// one and handed back once the cache is built (null: none).
+    GridLightGlobalTerm(const GridModel& model, const Light& light, RatesWorkspace* workspace)
         : model_(model)
         , light_(light) {
-        BrickVolume rates = model.buildRates(light);
+        BrickVolume rates =
+            workspace && workspace->rates ? std::move(*workspace->rates) : model.reserveRates();
+        if (workspace)
+            workspace->rates.reset();
+        model.fillRates(rates, light);
         if (model.options().evaluation == GridEvaluation::Cache)
             cache_ =
                 LightSpaceCache::build(rates, light, kOpaqueDepth, model.options().cacheSpacing);
@@ -222,6 +259,8 @@ public:
         // lanes per voxel) are kept only for marching, not for the whole render.
         if (!cache_)
             rates_.emplace(std::move(rates));
+        else if (workspace)
+            workspace->rates.emplace(std::move(rates));
     }
 
     std::size_t memoryBytes() const override {
@@ -309,9 +348,18 @@ private:
     std::optional<LightSpaceCache> cache_;
 };
 
-std::unique_ptr<LightGlobalTerm> GridModel::forLight(const Light& light) const {
+std::unique_ptr<LightWorkspace> GridModel::makeWorkspace() const {
+    return std::make_unique<RatesWorkspace>(*this);
+}
+
+std::unique_ptr<LightGlobalTerm> GridModel::forLight(const Light& light,
+                                                     LightWorkspace* workspace) const {
     throwIfInterrupted();
-    std::unique_ptr<LightGlobalTerm> term = std::make_unique<GridLightGlobalTerm>(*this, light);
+    auto* rates = dynamic_cast<RatesWorkspace*>(workspace);
+    if (workspace && (!rates || rates->model != this))
+        throw std::invalid_argument("grid global term: a workspace of another model");
+    std::unique_ptr<LightGlobalTerm> term =
+        std::make_unique<GridLightGlobalTerm>(*this, light, rates);
     if (settings_.groom)
         term = alongFibers(std::move(term), *settings_.groom,
                            options_.fiberSampleSpacing * static_cast<float>(voxelSize()));

@@ -5,7 +5,10 @@
 // forLight() prepares everything that depends on one light (for the grid mode
 // a cache volume of the global term) and returns a LightGlobalTerm that
 // evaluates batches of shading points. Every consumer — renderer, probe,
-// benchmark — switches modes only by building a different model.
+// benchmark — switches modes only by building a different model. Several
+// lights prepared one after another share a LightWorkspace: what a model
+// builds for every light alike (the grid modes' rates volume: its layout is
+// the fiber grid's, only its values depend on the light) is then built once.
 #pragma once
 
 #include <hairvox/core/vecmath.h>
@@ -97,11 +100,30 @@ struct GlobalTermSettings {
     void validate() const;
 };
 
+/// What a model keeps from one light's preparation for the next: made by
+/// GlobalTermModel::makeWorkspace(), passed to forLight() for each light in
+/// turn (one call at a time), and dropped once the lights are prepared — it
+/// holds memory no light keeps.
+class LightWorkspace {
+public:
+    virtual ~LightWorkspace() = default;
+};
+
 class GlobalTermModel {
 public:
     virtual ~GlobalTermModel() = default;
     virtual GlobalTermMode mode() const = 0;
-    virtual std::unique_ptr<LightGlobalTerm> forLight(const Light& light) const = 0;
+    /// Prepares one light.
+    std::unique_ptr<LightGlobalTerm> forLight(const Light& light) const {
+        return forLight(light, nullptr);
+    }
+    /// The same, reusing `workspace` (this model's makeWorkspace(); null:
+    /// none); the result does not depend on it. std::invalid_argument for
+    /// another model's workspace.
+    virtual std::unique_ptr<LightGlobalTerm> forLight(const Light& light,
+                                                      LightWorkspace* workspace) const = 0;
+    /// A workspace for forLight(), or null where the model has nothing to share.
+    virtual std::unique_ptr<LightWorkspace> makeWorkspace() const { return nullptr; }
 };
 
 /// The global term from the expected optical depths along a shadow path under
