@@ -84,43 +84,53 @@ public:
             c.offset = lineBytes_;
             lineBytes_ += std::size_t(width_) * (c.half ? sizeof(std::uint16_t) : sizeof(float));
         }
+        for (const FilmLayer& l : film.layers()) {
+            std::vector<std::size_t> of;
+            for (std::size_t i = 0; i < channels_.size(); ++i)
+                if (channels_[i].layer == &l)
+                    of.push_back(i);
+            layers_.push_back({&l, std::move(of)});
+        }
     }
 
     const std::vector<ExrChannel>& channels() const { return channels_; }
     std::size_t lineBytes() const { return lineBytes_; }
 
-    /// Scanline y as the file stores it, before compression.
-    void pack(int y, std::uint8_t* out) const {
+    /// Scanline y as the file stores it, before compression; `row` is the
+    /// caller's scratch for one layer's row.
+    void pack(int y, std::uint8_t* out, std::vector<float>& row) const {
         static_assert(std::endian::native == std::endian::little, "EXR files are little-endian");
-        constexpr int kTile = FilmLayer::kTileSize;
-        const auto row = std::size_t(y % kTile) * kTile;
-        for (const ExrChannel& c : channels_) {
-            const FilmLayer& l = *c.layer;
-            const auto stride = std::size_t(l.channels);
-            const std::size_t valueBytes = c.half ? sizeof(std::uint16_t) : sizeof(float);
-            for (int tx = 0; tx < l.tilesX(); ++tx) {
-                const int x0 = tx * kTile;
-                const auto n = std::size_t(std::min(kTile, width_ - x0));
-                std::uint8_t* dst = out + c.offset + std::size_t(x0) * valueBytes;
-                const float* t = l.tileOrNull(tx, y / kTile);
-                if (!t) { // +0 as half and as float: zero bytes
-                    std::memset(dst, 0, n * valueBytes);
-                    continue;
-                }
-                const float* src = t + row * stride + c.channel;
-                if (c.half)
-                    detail::toHalf(src, stride, n, reinterpret_cast<std::uint16_t*>(dst));
+        const auto width = std::size_t(width_);
+        for (const auto& [layer, channels] : layers_) {
+            const auto stride = std::size_t(layer->channels);
+            row.resize(width * stride);
+            const bool held = layer->copyRow(y, row.data());
+            for (const std::size_t i : channels) {
+                const ExrChannel& c = channels_[i];
+                std::uint8_t* dst = out + c.offset;
+                const float* src = row.data() + c.channel;
+                if (!held) // +0 as half and as float: zero bytes
+                    std::memset(dst, 0, width * (c.half ? sizeof(std::uint16_t) : sizeof(float)));
+                else if (c.half)
+                    detail::toHalf(src, stride, width, reinterpret_cast<std::uint16_t*>(dst));
                 else
-                    for (std::size_t x = 0; x < n; ++x)
+                    for (std::size_t x = 0; x < width; ++x)
                         std::memcpy(dst + x * sizeof(float), src + x * stride, sizeof(float));
             }
         }
     }
 
 private:
+    /// A film layer and its channels' places in channels_.
+    struct LayerChannels {
+        const FilmLayer* layer;
+        std::vector<std::size_t> channels;
+    };
+
     int width_;
     std::size_t lineBytes_ = 0;
     std::vector<ExrChannel> channels_;
+    std::vector<LayerChannels> layers_; ///< in the film's order
 };
 
 /// Scanlines per chunk: OpenEXR's, per compression.
@@ -138,7 +148,7 @@ public:
         const std::size_t bytes = layout.lineBytes() * std::size_t(rows);
         packed_.resize(bytes);
         for (int r = 0; r < rows; ++r)
-            layout.pack(y + r, packed_.data() + std::size_t(r) * layout.lineBytes());
+            layout.pack(y + r, packed_.data() + std::size_t(r) * layout.lineBytes(), row_);
         if (compression == ExrCompression::None)
             return {packed_.data(), bytes};
         // OpenEXR's predictor, then run lengths or zlib.
@@ -169,6 +179,7 @@ public:
 private:
     std::vector<std::uint8_t> packed_, predicted_, code_;
     std::vector<std::uint64_t> scratch_;
+    std::vector<float> row_; ///< one film layer's row (ExrLayout::pack)
 };
 
 exr_compression_t coreCompression(ExrCompression c) {

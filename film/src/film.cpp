@@ -34,18 +34,31 @@ std::size_t FilmLayer::tilesHeld() const {
         std::count_if(tiles_.begin(), tiles_.end(), [](const auto& t) { return t != nullptr; }));
 }
 
-std::vector<float> FilmLayer::dense() const {
+bool FilmLayer::copyRow(int y, float* out) const {
+    const int ty = y / kTileSize;
+    bool any = false;
+    for (int tx = 0; tx < tilesX_ && !any; ++tx)
+        any = tileOrNull(tx, ty) != nullptr;
+    if (!any)
+        return false;
     const auto c = std::size_t(channels);
-    std::vector<float> out(std::size_t(width_) * std::size_t(height_) * c, 0.0f);
+    for (int tx = 0; tx < tilesX_; ++tx) {
+        const int x0 = tx * kTileSize;
+        const std::size_t n = std::size_t(std::min(kTileSize, width_ - x0)) * c;
+        float* dst = out + std::size_t(x0) * c;
+        if (const float* t = tileOrNull(tx, ty))
+            std::copy_n(t + offset(x0, y), n, dst);
+        else
+            std::fill_n(dst, n, 0.0f);
+    }
+    return true;
+}
+
+std::vector<float> FilmLayer::dense() const {
+    const std::size_t row = std::size_t(width_) * std::size_t(channels);
+    std::vector<float> out(row * std::size_t(height_), 0.0f);
     for (int y = 0; y < height_; ++y)
-        for (int tx = 0; tx < tilesX_; ++tx)
-            if (const float* t = tileOrNull(tx, y / kTileSize)) {
-                const int x0 = tx * kTileSize, n = std::min(kTileSize, width_ - x0);
-                std::copy_n(t + offset(x0, y), std::size_t(n) * c,
-                            out.begin() +
-                                std::ptrdiff_t(
-                                    (std::size_t(y) * std::size_t(width_) + std::size_t(x0)) * c));
-            }
+        copyRow(y, out.data() + std::size_t(y) * row);
     return out;
 }
 

@@ -77,6 +77,14 @@ TEST(Film, HoldsOnlyTheTilesWrittenAndReadsZeroElsewhere) {
     EXPECT_EQ(layer.value(68, 39, 2), 0.0f);
     EXPECT_EQ(layer.dense()[film.index(69, 39) * 3 + 2], 5.0f);
     EXPECT_EQ(film.bytesHeld(), FilmLayer::kTilePixels * 3 * sizeof(float));
+    // A row: false, and nothing written, where its tiles are all not held;
+    // else zeros where a tile is not held.
+    std::vector<float> row(70 * 3, -1.0f);
+    EXPECT_FALSE(layer.copyRow(5, row.data()));
+    EXPECT_EQ(row, std::vector<float>(70 * 3, -1.0f));
+    ASSERT_TRUE(layer.copyRow(39, row.data()));
+    for (std::size_t i = 0; i < row.size(); ++i)
+        EXPECT_EQ(row[i], i == 69 * 3 + 2 ? 5.0f : 0.0f) << i;
 
     // assign() holds the tiles with anything but +0 (−0 is kept), and
     // dense() gives back what it was given.

@@ -95,6 +95,9 @@ public:
     /// Bytes the held tiles take.
     std::size_t bytesHeld() const { return tilesHeld() * tileFloats() * sizeof(float); }
 
+    /// Row y's width · channels values into `out`, zeros where no tile is
+    /// held; false, and `out` untouched, where the row's tiles are all not held.
+    bool copyRow(int y, float* out) const;
     /// Every pixel's channels, row-major: width · height · channels values.
     std::vector<float> dense() const;
     /// Sets every pixel from `values` (dense()'s order; size checked).
