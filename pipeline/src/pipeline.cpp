@@ -12,7 +12,6 @@
 #include <hairvox/strands/groom_io.h>
 #include <hairvox/transmittance/exact_global_term.h>
 
-#include <tbb/parallel_for.h>
 #include <tbb/task_group.h>
 
 #include <algorithm>
@@ -804,6 +803,9 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
     }
     row("tables", r.times.tables,
         strCat("dual-scattering tables (disk cache), ", r.fiberTypes, " fiber type(s)"));
+    const auto megabytes = [](std::uint64_t bytes) {
+        return (bytes + 500'000) / 1'000'000;
+    };
     std::uint64_t queries = 0, evaluated = 0, blocked = 0, empty = 0, skippedLights = 0, held = 0;
     for (const LightReport& l : r.lights) {
         held += l.heldBytes;
@@ -816,14 +818,14 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
     row("global term", r.times.globalTerm,
         thousands(queries) + " queries" +
             (evaluated < queries - blocked
-                 ? strCat(" (", thousands(evaluated), " evaluated, the rest interpolated along fibers)")
+                 ? strCat(" (", thousands(evaluated),
+                          " evaluated, the rest interpolated along fibers)")
                  : std::string()) +
-            "; skipped: " + thousands(skippedLights) + " light(s), " +
-            thousands(blocked) + " behind surfaces, " + thousands(empty) +
-            " with nothing in front" +
-            (held > 0 ? strCat("; ", (held + 500'000) / 1'000'000, " MB held") : std::string()));
+            "; skipped: " + thousands(skippedLights) + " light(s), " + thousands(blocked) +
+            " behind surfaces, " + thousands(empty) + " with nothing in front" +
+            (held > 0 ? strCat("; ", megabytes(held), " MB held") : std::string()));
     // What each light's preparation (the grid modes' cache) took: the lights
-    // are prepared concurrently, so these overlap within the stage's time.
+    // are prepared one after another, so these add up to the stage's time.
     std::string prepared;
     for (const LightReport& l : r.lights)
         if (!l.skipped) {
@@ -843,9 +845,6 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
             " segments outside the view, " + thousands(st.segmentTilesBehindSurfaces) +
             " segment-tiles behind surfaces, " + thousands(st.segmentTilesSkipped) +
             " segment-tiles opaque");
-    const auto megabytes = [](std::size_t bytes) {
-        return (bytes + 500'000) / 1'000'000;
-    };
     more(strCat("film: ", megabytes(r.film.bytesHeld()), " of ", megabytes(r.film.denseBytes()),
                 " MB held (a layer holds no ", Film::kTileSize, "-pixel tile that is all zero)"));
     const std::string rate =
