@@ -1,6 +1,7 @@
 #include "embree_util.h"
 
 #include <hairvox/core/error.h>
+#include <hairvox/core/thread_scratch.h>
 #include <hairvox/geometry/surface_scene.h>
 
 #include <embree3/rtcore.h>
@@ -209,8 +210,15 @@ bool SurfaceScene::occluded(const Vec3f& origin, const Vec3f& dir, float tMax) c
 void SurfaceScene::occluded(std::span<const Vec3f> origins, std::span<const Vec3f> dirs,
                             std::span<const float> tMax, std::span<std::uint8_t> blocked) const {
     // Spheres and the bounding box per segment; the rest go to Embree together.
-    std::vector<RTCRay> rays;
-    std::vector<std::uint32_t> rayOf;
+    struct Scratch {
+        std::vector<RTCRay> rays;
+        std::vector<std::uint32_t> rayOf;
+    };
+    ThreadScratch<Scratch> scratch;
+    std::vector<RTCRay>& rays = scratch->rays;
+    std::vector<std::uint32_t>& rayOf = scratch->rayOf;
+    rays.clear();
+    rayOf.clear();
     for (std::size_t i = 0; i < origins.size(); ++i) {
         const Occlusion o = empty() ? Occlusion::Open
                                     : occlusionBeforeMeshes(bounds_, spheres_, embree_ != nullptr,

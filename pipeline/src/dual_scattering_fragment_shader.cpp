@@ -1,6 +1,7 @@
 #include "dual_scattering_fragment_shader.h"
 
 #include <hairvox/core/math.h>
+#include <hairvox/core/thread_scratch.h>
 #include <hairvox/strands/groom.h>
 
 #include <chrono>
@@ -56,7 +57,17 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
     const std::size_t lightCount = lights_.size();
     const std::size_t stride = layout_.stride();
     std::fill(out.begin(), out.end(), 0.0f);
-    std::vector<GlobalTermQuery> queries(points.size());
+    // This thread's arrays from the batches before (every element written
+    // before it is read).
+    struct Scratch {
+        std::vector<GlobalTermQuery> queries;
+        std::vector<GlobalTerm> terms;
+        std::vector<ShadeBatch> batches;                 ///< per fiber type
+        std::vector<std::vector<std::uint32_t>> members; ///< per fiber type: its points
+    };
+    ThreadScratch<Scratch> scratch;
+    auto& [queries, terms, batches, members] = *scratch;
+    queries.resize(points.size());
     for (std::size_t i = 0; i < points.size(); ++i)
         queries[i] = {points[i].position,
                       points[i].tangent,
@@ -64,15 +75,13 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
                       true,
                       fiberTypeAt(fiberType_, points[i].segment),
                       points[i].segment};
-    std::vector<GlobalTerm> terms(points.size());
+    terms.resize(points.size());
     std::int64_t globalTermNanos = 0;
     std::vector<GlobalTermStats> batchStats(lightCount);
 
     // The points of each fiber type, shaded together per light (one batch
     // and no index list when the groom has one type).
     const std::size_t types = shaders_.size();
-    thread_local std::vector<ShadeBatch> batches;
-    thread_local std::vector<std::vector<std::uint32_t>> members;
     batches.resize(std::max(batches.size(), types));
     members.resize(std::max(members.size(), types));
     const auto pointOf = [&](std::size_t type, std::size_t k) {

@@ -771,9 +771,10 @@ private:
         // Isolated: a shader may run its own parallel loops (the global
         // term's lookups), and oneTBB allows a thread waiting in one to take
         // another tile's task ("Work Isolation"), which would reuse this
-        // thread's scratch (s_, and the shader's thread-local batches) under
-        // this tile. (Debian's oneTBB 2021.8 was not seen to do it: no
-        // re-entry in 2,000 nested loops at 2, 4 and 8 threads.)
+        // thread's scratch (s_) under this tile. (The shader's and the global
+        // term's per-thread arrays, ThreadScratch, take their own storage when
+        // re-entered. Debian's oneTBB 2021.8 was not seen to re-enter: none in
+        // 2,000 nested loops at 2, 4 and 8 threads.)
         tbb::this_task_arena::isolate([&] {
             ctx_.shader.shade(std::span(s_.points.data(), count),
                               std::span(s_.results.data(), count * stride_));

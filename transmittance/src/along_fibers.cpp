@@ -1,5 +1,6 @@
 // The global term sampled along the fibers and interpolated (alongFibers(),
 // global_term_model.h).
+#include <hairvox/core/thread_scratch.h>
 #include <hairvox/transmittance/global_term_model.h>
 
 #include <algorithm>
@@ -43,10 +44,16 @@ public:
             std::uint32_t sample;
             float f;
         };
-        std::vector<GlobalTermQuery> samples;
-        std::vector<Where> where(queries.size());
-        std::vector<int> needed; // sample numbers along the current segment
-        samples.reserve(queries.size());
+        struct Scratch {
+            std::vector<GlobalTermQuery> samples;
+            std::vector<Where> where; // every element written before it is read
+            std::vector<int> needed;  // sample numbers along the current segment
+            std::vector<GlobalTerm> values;
+        };
+        ThreadScratch<Scratch> scratch;
+        auto& [samples, where, needed, values] = *scratch;
+        samples.clear();
+        where.resize(queries.size());
         std::size_t i = 0;
         while (i < queries.size()) {
             const GlobalTermQuery& q = queries[i];
@@ -111,7 +118,7 @@ public:
             }
             i = end;
         }
-        std::vector<GlobalTerm> values(samples.size());
+        values.resize(samples.size()); // every element written by the inner term
         GlobalTermStats stats = inner_->evaluate(samples, values);
         for (std::size_t j = 0; j < queries.size(); ++j) {
             const Where w = where[j];

@@ -1,4 +1,5 @@
 #include <hairvox/core/error.h>
+#include <hairvox/core/thread_scratch.h>
 #include <hairvox/transmittance/global_term_model.h>
 
 #include <algorithm>
@@ -43,10 +44,22 @@ public:
 
     GlobalTermStats evaluate(std::span<const GlobalTermQuery> queries,
                              std::span<GlobalTerm> out) const override {
-        // One shadow segment per query, tested together.
-        std::vector<Vec3f> origins(queries.size()), dirs(queries.size());
-        std::vector<float> tMax(queries.size());
-        std::vector<std::uint8_t> occluded(queries.size());
+        // One shadow segment per query, tested together (every element of
+        // these arrays is written before it is read).
+        struct Scratch {
+            std::vector<Vec3f> origins, dirs;
+            std::vector<float> tMax;
+            std::vector<std::uint8_t> occluded;
+            std::vector<GlobalTermQuery> open;
+            std::vector<std::size_t> openIndex;
+            std::vector<GlobalTerm> openOut;
+        };
+        ThreadScratch<Scratch> scratch;
+        auto& [origins, dirs, tMax, occluded, open, openIndex, openOut] = *scratch;
+        origins.resize(queries.size());
+        dirs.resize(queries.size());
+        tMax.resize(queries.size());
+        occluded.resize(queries.size());
         for (std::size_t i = 0; i < queries.size(); ++i) {
             const Light::Path path = light_.pathFrom(queries[i].position);
             origins[i] = queries[i].position;
@@ -55,14 +68,14 @@ public:
         }
         surfaces_->occluded(origins, dirs, tMax, occluded);
         const auto blocked =
-            static_cast<std::size_t>(std::count(occluded.begin(), occluded.end(), 1));
+            static_cast<std::size_t>(std::count(occluded.begin(), occluded.end(), std::uint8_t(1)));
         GlobalTermStats stats;
         if (blocked == 0) {
             // The common batch: nothing to take out, nothing to copy.
             stats = inner_->evaluate(queries, out);
         } else {
-            std::vector<GlobalTermQuery> open;
-            std::vector<std::size_t> openIndex;
+            open.clear();
+            openIndex.clear();
             for (std::size_t i = 0; i < queries.size(); ++i) {
                 if (occluded[i]) {
                     out[i] = GlobalTerm::blocked();
@@ -71,7 +84,7 @@ public:
                     openIndex.push_back(i);
                 }
             }
-            std::vector<GlobalTerm> openOut(open.size());
+            openOut.resize(open.size());
             stats = inner_->evaluate(open, openOut);
             for (std::size_t k = 0; k < open.size(); ++k)
                 out[openIndex[k]] = openOut[k];

@@ -5,6 +5,7 @@
 
 #include <hairvox/core/error.h>
 #include <hairvox/core/interrupt.h>
+#include <hairvox/core/thread_scratch.h>
 #include <hairvox/transmittance/grid_global_term.h>
 #include <hairvox/voxelize/fiber_grid.h>
 
@@ -269,7 +270,12 @@ public:
 
     GlobalTermStats evaluate(std::span<const GlobalTermQuery> queries,
                              std::span<GlobalTerm> out) const override {
-        std::vector<unsigned char> empty(queries.size(), 0);
+        struct Scratch {
+            std::vector<unsigned char> empty; // per query: its path crossed no hair
+        };
+        ThreadScratch<Scratch> scratch;
+        std::vector<unsigned char>& empty = scratch->empty;
+        empty.resize(queries.size()); // every element written by evaluateBatch
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, queries.size(), kBatch),
                           [&](const tbb::blocked_range<std::size_t>& range) {
                               for (std::size_t b = range.begin(); b < range.end(); b += kBatch)
