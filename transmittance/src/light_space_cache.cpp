@@ -1,5 +1,7 @@
 #include "light_space_cache.h"
 
+#include <hairvox/core/thread_scratch.h>
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -7,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 namespace hairvox::detail {
 
@@ -86,26 +89,30 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates, 
     const auto samplesPerLine =
         static_cast<std::size_t>(std::ceil((sMaxWorld - cache.sBase_) / cache.h_)) + 2;
 
-    // Lines are integrated a tile a task, then laid end to end.
+    // Lines are integrated a tile a task. A task gathers a tile's runs and
+    // samples in its own arrays (reused from tile to tile, so they stay in
+    // cache) and stores them at their size.
     cache.tilesPerRow_ = static_cast<std::size_t>((cache.ni_ + kTile - 1) / kTile);
     const std::size_t tileCount =
         cache.tilesPerRow_ * static_cast<std::size_t>((cache.nj_ + kTile - 1) / kTile);
-    constexpr std::size_t kLinesPerTile = std::size_t(kTile) * kTile;
-    struct Block {
-        std::vector<std::uint64_t> lineRuns; ///< per line of the block, into runs
-        std::vector<Run> runs;               ///< begin: into samples
-        std::vector<Lanes> samples;
-    };
-    std::vector<Block> blocks(tileCount);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks.size()), [&](const auto& range) {
-        std::vector<BrickVolume::CumulativeSample> recorded;
-        for (std::size_t bi = range.begin(); bi != range.end(); ++bi) {
-            Block& block = blocks[bi];
-            block.lineRuns.reserve(kLinesPerTile);
-            const int tileI = static_cast<int>(bi % cache.tilesPerRow_) * kTile;
-            const int tileJ = static_cast<int>(bi / cache.tilesPerRow_) * kTile;
+    cache.lineRuns_.resize(tileCount * (kLinesPerTile + 1)); // every entry written below
+    cache.tiles_.resize(tileCount);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tileCount), [&](const auto& range) {
+        struct Scratch {
+            std::vector<BrickVolume::CumulativeSample> recorded;
+            std::vector<Run> runs;
+            std::vector<Lanes> samples;
+        };
+        ThreadScratch<Scratch> scratch;
+        auto& [recorded, runs, samples] = *scratch;
+        for (std::size_t ti = range.begin(); ti != range.end(); ++ti) {
+            runs.clear();
+            samples.clear();
+            std::uint32_t* lineRuns = cache.lineRuns_.data() + ti * (kLinesPerTile + 1);
+            const int tileI = static_cast<int>(ti % cache.tilesPerRow_) * kTile;
+            const int tileJ = static_cast<int>(ti / cache.tilesPerRow_) * kTile;
             for (std::size_t l = 0; l < kLinesPerTile; ++l) {
-                block.lineRuns.push_back(block.runs.size());
+                lineRuns[l] = static_cast<std::uint32_t>(runs.size());
                 const int li = tileI + static_cast<int>(l % kTile);
                 const int lj = tileJ + static_cast<int>(l / kTile);
                 if (li >= cache.ni_ || lj >= cache.nj_)
@@ -129,44 +136,43 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates, 
                         continue;
                     }
                     if (!keptPrevious || recorded[i].k != recorded[i - 1].k + 1)
-                        block.runs.push_back({static_cast<std::int32_t>(recorded[i].k),
-                                              block.samples.size()});
-                    block.samples.push_back(recorded[i].value);
+                        runs.push_back({static_cast<std::int32_t>(recorded[i].k),
+                                        static_cast<std::uint32_t>(samples.size())});
+                    samples.push_back(recorded[i].value);
                     keptPrevious = true;
                 }
+                // A tile's samples are at most its lines' lattice steps
+                // (samplesPerLine each), far below 2^32 for any volume that
+                // fits in memory; say so rather than wrap.
+                if (samples.size() > std::numeric_limits<std::uint32_t>::max() - 1)
+                    throw std::length_error("light-space cache: a tile of 16 x 16 shadow lines "
+                                            "holds more than 2^32 samples");
             }
+            lineRuns[kLinesPerTile] = static_cast<std::uint32_t>(runs.size());
+            if (runs.empty())
+                continue; // no line of the tile changes: nothing stored
+            runs.push_back({0, static_cast<std::uint32_t>(samples.size())}); // the sentinel
+            Tile& tile = cache.tiles_[ti];
+            tile.runs.assign(runs.begin(), runs.end());
+            tile.samples.assign(samples.begin(), samples.end());
         }
     });
-    // Offsets of each block's runs and samples in the whole, then the copies in parallel.
-    std::vector<std::uint64_t> runBase(blocks.size() + 1, 0), sampleBase(blocks.size() + 1, 0);
-    for (std::size_t bi = 0; bi < blocks.size(); ++bi) {
-        runBase[bi + 1] = runBase[bi] + blocks[bi].runs.size();
-        sampleBase[bi + 1] = sampleBase[bi] + blocks[bi].samples.size();
-    }
-    const std::size_t lines = tileCount * kLinesPerTile;
-    cache.lineRuns_.resize(lines + 1);
-    cache.runs_.resize(runBase.back() + 1);
-    cache.samples_ = LargeBuffer<Lanes>(sampleBase.back()); // written by the copies below
-    tbb::parallel_for(std::size_t(0), blocks.size(), [&](std::size_t bi) {
-        Block& block = blocks[bi];
-        for (std::size_t j = 0; j < block.lineRuns.size(); ++j)
-            cache.lineRuns_[bi * kLinesPerTile + j] = runBase[bi] + block.lineRuns[j];
-        for (std::size_t r = 0; r < block.runs.size(); ++r)
-            cache.runs_[runBase[bi] + r] = {block.runs[r].k0, sampleBase[bi] + block.runs[r].begin};
-        std::uninitialized_copy(block.samples.begin(), block.samples.end(),
-                                cache.samples_.begin() + sampleBase[bi]);
-        block = Block{}; // freed as soon as copied
-    });
-    cache.lineRuns_[lines] = runBase.back();
-    cache.runs_.back() = {0, sampleBase.back()};
     return cache;
 }
 
-std::size_t LightSpaceCache::sampleCount() const { return samples_.size(); }
+std::size_t LightSpaceCache::sampleCount() const {
+    std::size_t count = 0;
+    for (const Tile& tile : tiles_)
+        count += tile.samples.size();
+    return count;
+}
 
 std::size_t LightSpaceCache::memoryBytes() const {
-    return lineRuns_.capacity() * sizeof(std::uint64_t) + runs_.capacity() * sizeof(Run) +
-           samples_.bytes();
+    std::size_t bytes =
+        lineRuns_.capacity() * sizeof(std::uint32_t) + tiles_.capacity() * sizeof(Tile);
+    for (const Tile& tile : tiles_)
+        bytes += tile.runs.capacity() * sizeof(Run) + tile.samples.capacity() * sizeof(Lanes);
+    return bytes;
 }
 
 inline Vec3f LightSpaceCache::toLattice(const Vec3f& p) const {
@@ -189,19 +195,20 @@ Vec3f LightSpaceCache::lineOrigin(int i, int j, Vec3f& dir) const {
     return origin_ + sBase_ * dir;
 }
 
-inline LightSpaceCache::LineRead LightSpaceCache::alongLine(std::uint64_t r0, std::uint64_t r1,
-                                                            float s) const {
-    if (r0 == r1 || s < float(runs_[r0].k0))
+inline LightSpaceCache::LineRead LightSpaceCache::alongLine(const Tile& tile, std::uint32_t r0,
+                                                            std::uint32_t r1, float s) {
+    const Run* runs = tile.runs.data();
+    if (r0 == r1 || s < float(runs[r0].k0))
         return {}; // before the line's first change: zero
     // The last run starting at or before s (a line has a few).
-    std::uint64_t r = r0;
-    while (r + 1 < r1 && float(runs_[r + 1].k0) <= s)
+    std::uint32_t r = r0;
+    while (r + 1 < r1 && float(runs[r + 1].k0) <= s)
         ++r;
-    const Run& run = runs_[r];
-    const std::size_t count = runs_[r + 1].begin - run.begin;
+    const Run& run = runs[r];
+    const std::size_t count = runs[r + 1].begin - run.begin;
     const float local = s - float(run.k0);
     const auto k = static_cast<std::size_t>(local);
-    const Lanes* samples = samples_.data() + run.begin;
+    const Lanes* samples = tile.samples.data() + run.begin;
     if (k + 1 >= count)
         return {samples + (count - 1), nullptr, 0.0f}; // unchanged until the next run (or for good)
     return {samples + k, samples + k + 1, local - float(k)};
@@ -229,8 +236,9 @@ void LightSpaceCache::lookup(std::span<const Vec3f> points, std::span<OpticalDep
     struct Corner {
         bool inside = false;
         float w = 0;
-        std::size_t line = 0;
-        std::uint64_t r0 = 0, r1 = 0; ///< its runs
+        std::size_t line = 0; ///< into lineRuns_
+        const Tile* tile = nullptr;
+        std::uint32_t r0 = 0, r1 = 0; ///< its runs in its tile
         LineRead read;
     };
     std::array<std::array<Corner, 4>, kBatch> corners;
@@ -251,8 +259,11 @@ void LightSpaceCache::lookup(std::span<const Vec3f> points, std::span<OpticalDep
                 if (!c.inside)
                     continue;
                 c.w = ((k & 1) ? tx : 1.0f - tx) * ((k >> 1) ? ty : 1.0f - ty);
-                c.line = lineIndex(ii, jj);
+                const LineAt at = lineAt(ii, jj);
+                c.line = at.tile * (kLinesPerTile + 1) + at.line;
+                c.tile = &tiles_[at.tile];
                 __builtin_prefetch(&lineRuns_[c.line]);
+                __builtin_prefetch(c.tile);
             }
         }
         // 2. Each line's runs.
@@ -261,13 +272,13 @@ void LightSpaceCache::lookup(std::span<const Vec3f> points, std::span<OpticalDep
                 if (c.inside) {
                     c.r0 = lineRuns_[c.line];
                     c.r1 = lineRuns_[c.line + 1];
-                    __builtin_prefetch(&runs_[c.r0]);
+                    __builtin_prefetch(c.tile->runs.data() + c.r0);
                 }
         // 3. The run at s, and where its samples are.
         for (std::size_t q = 0; q < n; ++q)
             for (Corner& c : corners[q])
                 if (c.inside) {
-                    c.read = alongLine(c.r0, c.r1, s[q]);
+                    c.read = alongLine(*c.tile, c.r0, c.r1, s[q]);
                     if (c.read.a)
                         __builtin_prefetch(c.read.a);
                     if (c.read.b)

@@ -59,6 +59,42 @@ private:
     Vec3f toLattice(const Vec3f& p) const;
     /// A point of line (i, j) at lattice distance s.
     Vec3f lineOrigin(int i, int j, Vec3f& dir) const;
+    /// Lines are stored in tiles of kTile × kTile (row-major within a tile,
+    /// tiles row-major), the last row and column of tiles padded with lines
+    /// that hold nothing. A brick of 8³ voxels is crossed by some 8 × 8
+    /// neighbouring lines, which a tile integrates while the brick is in
+    /// cache (in rows of the whole lattice its values were read again a row
+    /// of lines later), and a query's 4 lines are mostly in one tile.
+    static constexpr int kTile = 16;
+    static constexpr std::size_t kLinesPerTile = std::size_t(kTile) * kTile;
+
+    /// Samples k0, k0 + 1, ... of a line, stored from its tile's
+    /// samples[begin] up to the next run's begin.
+    struct Run {
+        std::int32_t k0;
+        std::uint32_t begin;
+    };
+    /// What the lines of one tile store, each array allocated at its size
+    /// once the tile is integrated (neither grown nor gathered into one
+    /// array afterwards: at 0.5 mm voxels a light's cache is 150 MB, and
+    /// every byte written twice was a page faulted twice): the runs of its
+    /// lines one after another, and a sentinel whose begin is samples.size().
+    /// Both empty where no line of the tile changes.
+    struct Tile {
+        std::vector<Run> runs;
+        std::vector<Lanes> samples;
+    };
+    /// Where a line is stored: its tile and its place in the tile.
+    struct LineAt {
+        std::size_t tile;
+        std::size_t line;
+    };
+    LineAt lineAt(int i, int j) const {
+        const auto ti = static_cast<std::size_t>(i / kTile),
+                   tj = static_cast<std::size_t>(j / kTile);
+        return {tj * tilesPerRow_ + ti,
+                static_cast<std::size_t>(j % kTile) * kTile + static_cast<std::size_t>(i % kTile)};
+    }
     /// Where the stored integral of a line is read at a lattice distance:
     /// samples a and b (b = a + 1) mixed by t, or sample a alone (b null),
     /// or zero (a null: before the line's first change).
@@ -67,30 +103,10 @@ private:
         const Lanes* b = nullptr;
         float t = 0;
     };
-    /// The read at lattice distance s of the line whose runs are runs_[r0, r1).
-    LineRead alongLine(std::uint64_t r0, std::uint64_t r1, float s) const;
+    /// The read at lattice distance s of the line whose runs are tile.runs[r0, r1).
+    static LineRead alongLine(const Tile& tile, std::uint32_t r0, std::uint32_t r1, float s);
     /// The value a read gives.
     static Lanes value(const LineRead& read);
-    /// Where line (i, j) is stored: lines are kept in tiles of kTile × kTile
-    /// (row-major within a tile, tiles row-major), the last row and column
-    /// of tiles padded with lines that hold nothing. A brick of 8³ voxels is
-    /// crossed by some 8 × 8 neighbouring lines, which a tile integrates
-    /// while the brick is in cache (in rows of the whole lattice its values
-    /// were read again a row of lines later), and a query's 4 lines are
-    /// mostly in one tile.
-    std::size_t lineIndex(int i, int j) const {
-        const auto ti = static_cast<std::size_t>(i / kTile), tj = static_cast<std::size_t>(j / kTile);
-        return ((tj * tilesPerRow_ + ti) * kTile + static_cast<std::size_t>(j % kTile)) * kTile +
-               static_cast<std::size_t>(i % kTile);
-    }
-    static constexpr int kTile = 16;
-
-    /// Samples k0, k0 + 1, ... of a line, stored from samples_[begin] up to
-    /// the next run's begin.
-    struct Run {
-        std::int32_t k0;
-        std::uint64_t begin;
-    };
 
     bool perspective_ = false;
     Vec3f origin_{0.0f};                              ///< light position (perspective) or 0
@@ -100,11 +116,10 @@ private:
     float sBase_ = 0; ///< world distance of lattice s = 0 from the light plane/point
     int i0_ = 0, j0_ = 0, ni_ = 0, nj_ = 0; ///< line lattice [i0, i0 + ni) × [j0, j0 + nj)
     std::size_t tilesPerRow_ = 0;          ///< ⌈ni / kTile⌉
-    /// The runs of the line stored at l = lineIndex(i, j) are
-    /// runs_[lineRuns_[l], lineRuns_[l + 1]).
-    LargeVector<std::uint64_t> lineRuns_;
-    LargeVector<Run> runs_;               ///< and a sentinel whose begin is samples_.size()
-    LargeBuffer<Lanes> samples_; ///< on huge pages: queries read it scattered
+    /// The runs of line l of tile t are tiles_[t].runs[r0, r1) with
+    /// r0 = lineRuns_[t · (kLinesPerTile + 1) + l] and r1 the entry after it.
+    LargeVector<std::uint32_t> lineRuns_;
+    std::vector<Tile> tiles_;
 };
 
 } // namespace hairvox::detail
