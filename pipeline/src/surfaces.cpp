@@ -3,6 +3,7 @@
 #include <hairvox/core/interrupt.h>
 #include <hairvox/core/large_array.h>
 #include <hairvox/core/math.h>
+#include <hairvox/core/thread_scratch.h>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -21,10 +22,13 @@ constexpr int kEdgeSamples = 8;          ///< per side, in a silhouette or depth
 constexpr int kQuadrant = kEdgeSamples / 2;
 constexpr float kSmoothDepthRatio = 1.02f; ///< corners this close in depth: one smooth surface
 constexpr std::uint32_t kMiss = std::numeric_limits<std::uint32_t>::max();
+/// Rows shaded together (a task of the layer's loop).
+constexpr int kBandRows = 4;
+/// Points whose global term is evaluated together (per light).
+constexpr std::size_t kBatch = 1024;
 
-/// Where the camera ray through a raster position meets the surfaces. No
-/// member initialisers (castView() sets every member), so that the samples'
-/// LargeVector is not written before the rows' samples are copied in.
+/// Where the camera ray through a raster position meets the surfaces
+/// (castView() sets every member).
 struct ViewSample {
     std::uint32_t surface; ///< kMiss where the ray met nothing
     float depth;           ///< camera-space z
@@ -97,99 +101,107 @@ SurfaceLayer surfaceLayer(const SurfaceScene& surfaces, const std::vector<Rgb>& 
     });
     throwIfInterrupted();
 
-    // 2. Coverage and depth per pixel; the points to shade, per row (in pixel order).
-    std::vector<std::vector<ShadingSample>> rows(static_cast<std::size_t>(height));
-    tbb::parallel_for(0, height, [&](int y) {
-        std::vector<ShadingSample>& out = rows[std::size_t(y)];
-        std::uninitialized_fill_n(layer.radiance.begin() + std::size_t(y) * std::size_t(width),
-                                  width, Rgb(0.0f));
-        for (int x = 0; x < width; ++x) {
-            const std::size_t p = std::size_t(y) * std::size_t(width) + std::size_t(x);
-            const CornerHit* c[4] = {&corners[std::size_t(y) * cornerRow + std::size_t(x)],
-                                      &corners[std::size_t(y) * cornerRow + std::size_t(x) + 1],
-                                      &corners[std::size_t(y + 1) * cornerRow + std::size_t(x)],
-                                      &corners[std::size_t(y + 1) * cornerRow + std::size_t(x) + 1]};
-            int hits = 0;
-            bool sameSurface = true;
-            float zMin = std::numeric_limits<float>::infinity(), zMax = 0;
-            for (const CornerHit* s : c) {
-                if (s->surface == kMiss)
-                    continue;
-                ++hits;
-                sameSurface = sameSurface && s->surface == c[0]->surface;
-                zMin = std::min(zMin, s->depth);
-                zMax = std::max(zMax, s->depth);
-            }
-            layer.coverage[p] = 0.0f;
-            layer.depth[p] = 0.0f;
-            if (hits == 0)
-                continue;
-            if (hits == 4 && sameSurface && zMax <= kSmoothDepthRatio * zMin) {
-                const ViewSample centre =
-                    castView(surfaces, camera, Vec2f(float(x) + 0.5f, float(y) + 0.5f));
-                if (centre.surface == c[0]->surface) {
-                    layer.coverage[p] = 1.0f;
-                    layer.depth[p] = centre.depth;
-                    out.push_back({p, 1.0f, centre});
-                    continue;
+    // 2. A band of rows a task: coverage and depth per pixel, the points to
+    // shade (in pixel order), and their Lambertian radiance lit through the
+    // hair, light by light, added into their pixels. A band's points live in
+    // its thread's arrays only: gathered for the whole image they were the
+    // layer's largest memory (Ratboy at 1280²: ~0.7M points of 64 bytes,
+    // held per row, copied into one array, with a radiance each), and on
+    // this VM fresh memory is time (docs/DESIGN.md §7).
+    const int bands = (height + kBandRows - 1) / kBandRows;
+    tbb::parallel_for(0, bands, [&](int band) {
+        throwIfInterrupted();
+        struct Scratch {
+            std::vector<ShadingSample> samples;
+            std::vector<Rgb> radiance; ///< per sample
+            std::vector<GlobalTermQuery> queries;
+            std::vector<std::size_t> which; ///< per query: its sample
+            std::vector<float> cosines;     ///< per query
+            std::vector<GlobalTerm> terms;  ///< per query
+        };
+        ThreadScratch<Scratch> scratch;
+        auto& [samples, radiance, queries, which, cosines, g] = *scratch;
+        samples.clear();
+        const int yEnd = std::min(height, (band + 1) * kBandRows);
+        for (int y = band * kBandRows; y < yEnd; ++y) {
+            std::uninitialized_fill_n(layer.radiance.begin() + std::size_t(y) * std::size_t(width),
+                                      width, Rgb(0.0f));
+            for (int x = 0; x < width; ++x) {
+                const std::size_t p = std::size_t(y) * std::size_t(width) + std::size_t(x);
+                const CornerHit* c[4] = {
+                    &corners[std::size_t(y) * cornerRow + std::size_t(x)],
+                    &corners[std::size_t(y) * cornerRow + std::size_t(x) + 1],
+                    &corners[std::size_t(y + 1) * cornerRow + std::size_t(x)],
+                    &corners[std::size_t(y + 1) * cornerRow + std::size_t(x) + 1]};
+                int hits = 0;
+                bool sameSurface = true;
+                float zMin = std::numeric_limits<float>::infinity(), zMax = 0;
+                for (const CornerHit* s : c) {
+                    if (s->surface == kMiss)
+                        continue;
+                    ++hits;
+                    sameSurface = sameSurface && s->surface == c[0]->surface;
+                    zMin = std::min(zMin, s->depth);
+                    zMax = std::max(zMax, s->depth);
                 }
-            }
-            // A silhouette or a depth edge: 8×8 samples, one shaded per quadrant.
-            int covered = 0;
-            double depthSum = 0;
-            const std::size_t firstShaded = out.size();
-            for (int qy = 0; qy < 2; ++qy)
-                for (int qx = 0; qx < 2; ++qx) {
-                    int quadrantHits = 0;
-                    ViewSample shaded{};
-                    for (int j = qy * kQuadrant; j < (qy + 1) * kQuadrant; ++j)
-                        for (int i = qx * kQuadrant; i < (qx + 1) * kQuadrant; ++i) {
-                            const ViewSample s = castView(
-                                surfaces, camera,
-                                Vec2f(float(x) + (float(i) + 0.5f) / kEdgeSamples,
-                                      float(y) + (float(j) + 0.5f) / kEdgeSamples));
-                            if (s.surface == kMiss)
-                                continue;
-                            if (quadrantHits++ == 0)
-                                shaded = s;
-                            depthSum += double(s.depth);
-                        }
-                    covered += quadrantHits;
-                    if (quadrantHits > 0)
-                        out.push_back({p, float(quadrantHits), shaded});
+                layer.coverage[p] = 0.0f;
+                layer.depth[p] = 0.0f;
+                if (hits == 0)
+                    continue;
+                if (hits == 4 && sameSurface && zMax <= kSmoothDepthRatio * zMin) {
+                    const ViewSample centre =
+                        castView(surfaces, camera, Vec2f(float(x) + 0.5f, float(y) + 0.5f));
+                    if (centre.surface == c[0]->surface) {
+                        layer.coverage[p] = 1.0f;
+                        layer.depth[p] = centre.depth;
+                        samples.push_back({p, 1.0f, centre});
+                        continue;
+                    }
                 }
-            if (covered == 0)
-                continue;
-            layer.coverage[p] = float(covered) / float(kEdgeSamples * kEdgeSamples);
-            layer.depth[p] = static_cast<float>(depthSum / covered);
-            for (std::size_t k = firstShaded; k < out.size(); ++k)
-                out[k].weight /= float(covered);
+                // A silhouette or a depth edge: 8×8 samples, one shaded per quadrant.
+                int covered = 0;
+                double depthSum = 0;
+                const std::size_t firstShaded = samples.size();
+                for (int qy = 0; qy < 2; ++qy)
+                    for (int qx = 0; qx < 2; ++qx) {
+                        int quadrantHits = 0;
+                        ViewSample shaded{};
+                        for (int j = qy * kQuadrant; j < (qy + 1) * kQuadrant; ++j)
+                            for (int i = qx * kQuadrant; i < (qx + 1) * kQuadrant; ++i) {
+                                const ViewSample s =
+                                    castView(surfaces, camera,
+                                             Vec2f(float(x) + (float(i) + 0.5f) / kEdgeSamples,
+                                                   float(y) + (float(j) + 0.5f) / kEdgeSamples));
+                                if (s.surface == kMiss)
+                                    continue;
+                                if (quadrantHits++ == 0)
+                                    shaded = s;
+                                depthSum += double(s.depth);
+                            }
+                        covered += quadrantHits;
+                        if (quadrantHits > 0)
+                            samples.push_back({p, float(quadrantHits), shaded});
+                    }
+                if (covered == 0)
+                    continue;
+                layer.coverage[p] = float(covered) / float(kEdgeSamples * kEdgeSamples);
+                layer.depth[p] = static_cast<float>(depthSum / covered);
+                for (std::size_t k = firstShaded; k < samples.size(); ++k)
+                    samples[k].weight /= float(covered);
+            }
         }
-    });
-    throwIfInterrupted();
-    // The rows' samples laid end to end (row y's from rowStart[y]).
-    std::vector<std::size_t> rowStart(rows.size() + 1, 0);
-    for (std::size_t y = 0; y < rows.size(); ++y)
-        rowStart[y + 1] = rowStart[y] + rows[y].size();
-    LargeVector<ShadingSample> samples(rowStart.back());
-    tbb::parallel_for(std::size_t(0), rows.size(), [&](std::size_t y) {
-        std::copy(rows[y].begin(), rows[y].end(), samples.begin() + std::ptrdiff_t(rowStart[y]));
-        rows[y] = {};
-    });
 
-    // 3. Lambertian radiance lit through the hair, light by light.
-    std::vector<Rgb> radiance(samples.size(), Rgb(0.0f));
-    constexpr std::size_t kBatch = 1024;
-    for (std::size_t l = 0; l < lights.size(); ++l) {
-        if (!terms[l])
-            continue;
-        const Light& light = lights[l];
-        tbb::parallel_for(
-            tbb::blocked_range<std::size_t>(0, samples.size(), kBatch), [&](const auto& range) {
-                std::vector<GlobalTermQuery> queries;
-                std::vector<std::size_t> which;
-                std::vector<float> cosines;
-                for (std::size_t i = range.begin(); i != range.end(); ++i) {
+        radiance.assign(samples.size(), Rgb(0.0f));
+        for (std::size_t l = 0; l < lights.size(); ++l) {
+            if (!terms[l])
+                continue;
+            const Light& light = lights[l];
+            for (std::size_t begin = 0; begin < samples.size(); begin += kBatch) {
+                const std::size_t end = std::min(samples.size(), begin + kBatch);
+                queries.clear();
+                which.clear();
+                cosines.clear();
+                for (std::size_t i = begin; i != end; ++i) {
                     const ViewSample& v = samples[i].view;
                     const Vec3f x = v.position + surfaceOffset(v.position) * v.geometricNormal;
                     const Light::Path path = light.pathFrom(x);
@@ -204,7 +216,7 @@ SurfaceLayer surfaceLayer(const SurfaceScene& surfaces, const std::vector<Rgb>& 
                     which.push_back(i);
                     cosines.push_back(cosTheta);
                 }
-                std::vector<GlobalTerm> g(queries.size());
+                g.resize(queries.size()); // every element written by evaluate
                 terms[l]->evaluate(queries, g);
                 for (std::size_t k = 0; k < queries.size(); ++k) {
                     const std::size_t i = which[k];
@@ -213,14 +225,12 @@ SurfaceLayer surfaceLayer(const SurfaceScene& surfaces, const std::vector<Rgb>& 
                                    light.irradiance(distance) * cosines[k] *
                                    (Rgb(g[k].V) + g[k].T_s);
                 }
-            });
-        throwIfInterrupted();
-    }
-    // Row by row: a row's samples are its pixels'.
-    tbb::parallel_for(0, height, [&](int y) {
-        for (std::size_t i = rowStart[std::size_t(y)]; i < rowStart[std::size_t(y) + 1]; ++i)
+            }
+        }
+        for (std::size_t i = 0; i < samples.size(); ++i)
             layer.radiance[samples[i].pixel] += samples[i].weight * radiance[i];
     });
+    throwIfInterrupted();
     return layer;
 }
 
