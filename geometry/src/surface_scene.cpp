@@ -140,38 +140,96 @@ Vec3f windingNormal(const TriangleMesh& mesh, std::uint32_t triangle) {
 
 } // namespace
 
-std::optional<SurfaceHit> SurfaceScene::intersect(const Vec3f& origin, const Vec3f& dir,
-                                                  float tMax) const {
-    if (empty() || !segmentMeetsBox(bounds_, origin, dir, tMax))
-        return std::nullopt;
+namespace {
+
+/// The nearest sphere on origin + t·dir before `nearest` (which it lowers to
+/// the hit's t).
+std::optional<SurfaceHit> nearestSphereHit(std::span<const Sphere> spheres, const Vec3f& origin,
+                                           const Vec3f& dir, float& nearest) {
     std::optional<SurfaceHit> best;
-    float nearest = tMax;
-    for (std::size_t i = 0; i < spheres_.size(); ++i) {
-        const float t = spheres_[i].intersect(origin, dir, nearest);
+    for (std::size_t i = 0; i < spheres.size(); ++i) {
+        const float t = spheres[i].intersect(origin, dir, nearest);
         if (t > 0 && t < nearest) {
             nearest = t;
-            const Vec3f n = normalizeOr(origin + t * dir - spheres_[i].center, -dir);
+            const Vec3f n = normalizeOr(origin + t * dir - spheres[i].center, -dir);
             const Vec3f facing = glm::dot(n, dir) > 0 ? -n : n;
             best = SurfaceHit{t, static_cast<std::uint32_t>(i), facing, facing};
         }
     }
-    if (embree_) {
-        if (const std::optional<MeshHit> h = nearestMeshHit(embree_->scene, origin, dir, nearest)) {
-            const TriangleMesh& mesh = meshes_[h->mesh];
-            Vec3f ng = windingNormal(mesh, h->triangle);
-            if (glm::dot(ng, dir) > 0)
-                ng = -ng;
-            Vec3f ns = ng;
-            if (!mesh.cornerNormals.empty()) {
-                const Vec3f* n = &mesh.cornerNormals[3 * std::size_t(h->triangle)];
-                ns = normalizeOr((1.0f - h->u - h->v) * n[0] + h->u * n[1] + h->v * n[2], ng);
-                if (glm::dot(ns, ng) < 0)
-                    ns = -ns;
-            }
-            best = SurfaceHit{h->t, static_cast<std::uint32_t>(spheres_.size() + h->mesh), ns, ng};
-        }
-    }
     return best;
+}
+
+/// The surface hit of a mesh hit on a ray along `dir`: its normals, facing the ray's origin.
+SurfaceHit surfaceHit(std::span<const TriangleMesh> meshes, std::size_t sphereCount,
+                      const MeshHit& h, const Vec3f& dir) {
+    const TriangleMesh& mesh = meshes[h.mesh];
+    Vec3f ng = windingNormal(mesh, h.triangle);
+    if (glm::dot(ng, dir) > 0)
+        ng = -ng;
+    Vec3f ns = ng;
+    if (!mesh.cornerNormals.empty()) {
+        const Vec3f* n = &mesh.cornerNormals[3 * std::size_t(h.triangle)];
+        ns = normalizeOr((1.0f - h.u - h.v) * n[0] + h.u * n[1] + h.v * n[2], ng);
+        if (glm::dot(ns, ng) < 0)
+            ns = -ns;
+    }
+    return SurfaceHit{h.t, static_cast<std::uint32_t>(sphereCount + h.mesh), ns, ng};
+}
+
+} // namespace
+
+std::optional<SurfaceHit> SurfaceScene::intersect(const Vec3f& origin, const Vec3f& dir,
+                                                  float tMax) const {
+    if (empty() || !segmentMeetsBox(bounds_, origin, dir, tMax))
+        return std::nullopt;
+    float nearest = tMax;
+    std::optional<SurfaceHit> best = nearestSphereHit(spheres_, origin, dir, nearest);
+    if (embree_)
+        if (const std::optional<MeshHit> h = nearestMeshHit(embree_->scene, origin, dir, nearest))
+            best = surfaceHit(meshes_, spheres_.size(), *h, dir);
+    return best;
+}
+
+void SurfaceScene::intersect(std::span<const Vec3f> origins, std::span<const Vec3f> dirs,
+                             float tMax, std::span<std::optional<SurfaceHit>> hits) const {
+    // Spheres and the bounding box per ray; the rest go to Embree together.
+    struct Scratch {
+        std::vector<RTCRayHit> rays;
+        std::vector<std::uint32_t> rayOf;
+    };
+    ThreadScratch<Scratch> scratch;
+    auto& [rays, rayOf] = *scratch;
+    rays.clear();
+    rayOf.clear();
+    for (std::size_t i = 0; i < origins.size(); ++i) {
+        hits[i].reset();
+        if (empty() || !segmentMeetsBox(bounds_, origins[i], dirs[i], tMax))
+            continue;
+        float nearest = tMax;
+        hits[i] = nearestSphereHit(spheres_, origins[i], dirs[i], nearest);
+        if (!embree_)
+            continue;
+        RTCRayHit& ray = rays.emplace_back();
+        ray.ray = makeRay(origins[i], dirs[i], nearest);
+        ray.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rayOf.push_back(static_cast<std::uint32_t>(i));
+    }
+    if (rays.empty())
+        return;
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    rtcIntersect1M(embree_->scene, &context, rays.data(), static_cast<unsigned>(rays.size()),
+                   sizeof(RTCRayHit));
+    for (std::size_t k = 0; k < rays.size(); ++k) {
+        const RTCRayHit& r = rays[k];
+        if (r.hit.geomID == RTC_INVALID_GEOMETRY_ID)
+            continue;
+        const std::uint32_t i = rayOf[k];
+        hits[i] =
+            surfaceHit(meshes_, spheres_.size(),
+                       MeshHit{r.ray.tfar, r.hit.geomID, r.hit.primID, r.hit.u, r.hit.v}, dirs[i]);
+    }
 }
 
 namespace {

@@ -9,10 +9,12 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <span>
 
 namespace hairvox::detail {
 
@@ -20,6 +22,7 @@ namespace {
 
 constexpr int kEdgeSamples = 8;          ///< per side, in a silhouette or depth-edge pixel
 constexpr int kQuadrant = kEdgeSamples / 2;
+constexpr auto kQuadrantSamples = std::size_t(kQuadrant * kQuadrant);
 constexpr float kSmoothDepthRatio = 1.02f; ///< corners this close in depth: one smooth surface
 constexpr std::uint32_t kMiss = std::numeric_limits<std::uint32_t>::max();
 /// Rows shaded together (a task of the layer's loop).
@@ -28,7 +31,7 @@ constexpr int kBandRows = 4;
 constexpr std::size_t kBatch = 1024;
 
 /// Where the camera ray through a raster position meets the surfaces
-/// (castView() sets every member).
+/// (castViews() sets every member).
 struct ViewSample {
     std::uint32_t surface; ///< kMiss where the ray met nothing
     float depth;           ///< camera-space z
@@ -37,22 +40,43 @@ struct ViewSample {
     Vec3f geometricNormal;
 };
 
-ViewSample castView(const SurfaceScene& surfaces, const Camera& camera, const Vec2f& raster) {
-    const Vec3f dirCam = camera.rayDirection(raster);
-    const Vec3f dir = camera.toWorldDirection(dirCam);
-    // Geometry nearer than the near plane is clipped, as for the hair.
-    const float tNear = camera.nearClip() / dirCam.z;
-    const Vec3f origin = camera.position() + tNear * dir;
-    ViewSample s{kMiss, 0.0f, Vec3f(0.0f), Vec3f(0.0f), Vec3f(0.0f)};
-    if (const std::optional<SurfaceHit> hit =
-            surfaces.intersect(origin, dir, std::numeric_limits<float>::infinity())) {
-        s.surface = hit->surface;
-        s.depth = (tNear + hit->t) * dirCam.z;
-        s.position = origin + hit->t * dir;
-        s.normal = hit->normal;
-        s.geometricNormal = hit->geometricNormal;
+/// The camera rays through `rasters`, traced together (SurfaceScene's stream
+/// of coherent rays: a row of pixels, a pixel's sub-samples), into `out`.
+void castViews(const SurfaceScene& surfaces, const Camera& camera, std::span<const Vec2f> rasters,
+               std::span<ViewSample> out) {
+    struct Scratch {
+        std::vector<Vec3f> origins, dirs;
+        std::vector<float> tNear, dirZ; ///< from the camera to the origin; dir's camera-space z
+        std::vector<std::optional<SurfaceHit>> hits;
+    };
+    ThreadScratch<Scratch> scratch;
+    auto& [origins, dirs, tNear, dirZ, hits] = *scratch;
+    const std::size_t n = rasters.size();
+    origins.resize(n); // every element of these written below
+    dirs.resize(n);
+    tNear.resize(n);
+    dirZ.resize(n);
+    hits.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        const Vec3f dirCam = camera.rayDirection(rasters[i]);
+        dirs[i] = camera.toWorldDirection(dirCam);
+        // Geometry nearer than the near plane is clipped, as for the hair.
+        tNear[i] = camera.nearClip() / dirCam.z;
+        dirZ[i] = dirCam.z;
+        origins[i] = camera.position() + tNear[i] * dirs[i];
     }
-    return s;
+    surfaces.intersect(origins, dirs, std::numeric_limits<float>::infinity(), hits);
+    for (std::size_t i = 0; i < n; ++i) {
+        ViewSample& s = out[i];
+        s = {kMiss, 0.0f, Vec3f(0.0f), Vec3f(0.0f), Vec3f(0.0f)};
+        if (const std::optional<SurfaceHit>& hit = hits[i]) {
+            s.surface = hit->surface;
+            s.depth = (tNear[i] + hit->t) * dirZ[i];
+            s.position = origins[i] + hit->t * dirs[i];
+            s.normal = hit->normal;
+            s.geometricNormal = hit->geometricNormal;
+        }
+    }
 }
 
 /// What a pixel-corner ray met (8 bytes: one per pixel of the image). No
@@ -94,10 +118,20 @@ SurfaceLayer surfaceLayer(const SurfaceScene& surfaces, const std::vector<Rgb>& 
     const std::size_t cornerRow = std::size_t(width) + 1;
     LargeVector<CornerHit> corners(cornerRow * (std::size_t(height) + 1));
     tbb::parallel_for(0, height + 1, [&](int y) {
-        for (int x = 0; x <= width; ++x) {
-            const ViewSample s = castView(surfaces, camera, Vec2f(float(x), float(y)));
-            corners[std::size_t(y) * cornerRow + std::size_t(x)] = {s.surface, s.depth};
-        }
+        struct Scratch {
+            std::vector<Vec2f> rasters;
+            std::vector<ViewSample> views;
+        };
+        ThreadScratch<Scratch> scratch;
+        auto& [rasters, views] = *scratch;
+        rasters.clear();
+        for (int x = 0; x <= width; ++x)
+            rasters.emplace_back(float(x), float(y));
+        views.resize(rasters.size());
+        castViews(surfaces, camera, rasters, views);
+        for (int x = 0; x <= width; ++x)
+            corners[std::size_t(y) * cornerRow + std::size_t(x)] = {views[std::size_t(x)].surface,
+                                                                    views[std::size_t(x)].depth};
     });
     throwIfInterrupted();
 
@@ -118,70 +152,93 @@ SurfaceLayer surfaceLayer(const SurfaceScene& surfaces, const std::vector<Rgb>& 
             std::vector<std::size_t> which; ///< per query: its sample
             std::vector<float> cosines;     ///< per query
             std::vector<GlobalTerm> terms;  ///< per query
+            std::vector<std::uint8_t> smooth; ///< per pixel of a row: its centre is cast
+            std::vector<Vec2f> rasters, edgeRasters;
+            std::vector<ViewSample> views;     ///< the row's smooth pixels' centres
+            std::vector<ViewSample> edgeViews; ///< an edge pixel's 8×8 samples
         };
         ThreadScratch<Scratch> scratch;
-        auto& [samples, radiance, queries, which, cosines, g] = *scratch;
+        auto& [samples, radiance, queries, which, cosines, g, smooth, rasters, edgeRasters, views,
+               edgeViews] = *scratch;
         samples.clear();
         const int yEnd = std::min(height, (band + 1) * kBandRows);
         for (int y = band * kBandRows; y < yEnd; ++y) {
             std::uninitialized_fill_n(layer.radiance.begin() + std::size_t(y) * std::size_t(width),
                                       width, Rgb(0.0f));
+            const auto cornersOf = [&](int x) {
+                const std::size_t c = std::size_t(y) * cornerRow + std::size_t(x);
+                return std::array<const CornerHit*, 4>{&corners[c], &corners[c + 1],
+                                                       &corners[c + cornerRow],
+                                                       &corners[c + cornerRow + 1]};
+            };
+            // The pixels whose four corners meet one surface at about one
+            // depth: their centres, cast as one stream.
+            smooth.assign(std::size_t(width), 0);
+            rasters.clear();
+            for (int x = 0; x < width; ++x) {
+                const auto c = cornersOf(x);
+                bool oneSurface = c[0]->surface != kMiss;
+                float zMin = std::numeric_limits<float>::infinity(), zMax = 0;
+                for (const CornerHit* h : c) {
+                    oneSurface = oneSurface && h->surface == c[0]->surface;
+                    zMin = std::min(zMin, h->depth);
+                    zMax = std::max(zMax, h->depth);
+                }
+                if (oneSurface && zMax <= kSmoothDepthRatio * zMin) {
+                    smooth[std::size_t(x)] = 1;
+                    rasters.emplace_back(float(x) + 0.5f, float(y) + 0.5f);
+                }
+            }
+            views.resize(rasters.size());
+            castViews(surfaces, camera, rasters, views);
+            std::size_t centre = 0;
             for (int x = 0; x < width; ++x) {
                 const std::size_t p = std::size_t(y) * std::size_t(width) + std::size_t(x);
-                const CornerHit* c[4] = {
-                    &corners[std::size_t(y) * cornerRow + std::size_t(x)],
-                    &corners[std::size_t(y) * cornerRow + std::size_t(x) + 1],
-                    &corners[std::size_t(y + 1) * cornerRow + std::size_t(x)],
-                    &corners[std::size_t(y + 1) * cornerRow + std::size_t(x) + 1]};
-                int hits = 0;
-                bool sameSurface = true;
-                float zMin = std::numeric_limits<float>::infinity(), zMax = 0;
-                for (const CornerHit* s : c) {
-                    if (s->surface == kMiss)
-                        continue;
-                    ++hits;
-                    sameSurface = sameSurface && s->surface == c[0]->surface;
-                    zMin = std::min(zMin, s->depth);
-                    zMax = std::max(zMax, s->depth);
-                }
+                const auto c = cornersOf(x);
                 layer.coverage[p] = 0.0f;
                 layer.depth[p] = 0.0f;
-                if (hits == 0)
-                    continue;
-                if (hits == 4 && sameSurface && zMax <= kSmoothDepthRatio * zMin) {
-                    const ViewSample centre =
-                        castView(surfaces, camera, Vec2f(float(x) + 0.5f, float(y) + 0.5f));
-                    if (centre.surface == c[0]->surface) {
+                if (smooth[std::size_t(x)]) {
+                    const ViewSample& v = views[centre++];
+                    if (v.surface == c[0]->surface) {
                         layer.coverage[p] = 1.0f;
-                        layer.depth[p] = centre.depth;
-                        samples.push_back({p, 1.0f, centre});
+                        layer.depth[p] = v.depth;
+                        samples.push_back({p, 1.0f, v});
                         continue;
                     }
+                } else if (std::none_of(c.begin(), c.end(),
+                                        [](const CornerHit* h) { return h->surface != kMiss; })) {
+                    continue;
                 }
-                // A silhouette or a depth edge: 8×8 samples, one shaded per quadrant.
+                // A silhouette or a depth edge: 8×8 samples (one stream), one
+                // shaded per 4×4 quadrant.
+                edgeRasters.clear();
+                for (int qy = 0; qy < 2; ++qy)
+                    for (int qx = 0; qx < 2; ++qx)
+                        for (int j = qy * kQuadrant; j < (qy + 1) * kQuadrant; ++j)
+                            for (int i = qx * kQuadrant; i < (qx + 1) * kQuadrant; ++i)
+                                edgeRasters.emplace_back(
+                                    float(x) + (float(i) + 0.5f) / kEdgeSamples,
+                                    float(y) + (float(j) + 0.5f) / kEdgeSamples);
+                edgeViews.resize(edgeRasters.size());
+                castViews(surfaces, camera, edgeRasters, edgeViews);
                 int covered = 0;
                 double depthSum = 0;
                 const std::size_t firstShaded = samples.size();
-                for (int qy = 0; qy < 2; ++qy)
-                    for (int qx = 0; qx < 2; ++qx) {
-                        int quadrantHits = 0;
-                        ViewSample shaded{};
-                        for (int j = qy * kQuadrant; j < (qy + 1) * kQuadrant; ++j)
-                            for (int i = qx * kQuadrant; i < (qx + 1) * kQuadrant; ++i) {
-                                const ViewSample s =
-                                    castView(surfaces, camera,
-                                             Vec2f(float(x) + (float(i) + 0.5f) / kEdgeSamples,
-                                                   float(y) + (float(j) + 0.5f) / kEdgeSamples));
-                                if (s.surface == kMiss)
-                                    continue;
-                                if (quadrantHits++ == 0)
-                                    shaded = s;
-                                depthSum += double(s.depth);
-                            }
-                        covered += quadrantHits;
-                        if (quadrantHits > 0)
-                            samples.push_back({p, float(quadrantHits), shaded});
+                for (std::size_t q = 0; q < 4; ++q) {
+                    int quadrantHits = 0;
+                    ViewSample shaded{};
+                    for (std::size_t k = 0; k < kQuadrantSamples; ++k) {
+                        const ViewSample& s = edgeViews[q * kQuadrantSamples + k];
+                        if (s.surface == kMiss)
+                            continue;
+                        if (quadrantHits++ == 0)
+                            shaded = s;
+                        depthSum += double(s.depth);
                     }
+                    covered += quadrantHits;
+                    if (quadrantHits > 0)
+                        samples.push_back({p, float(quadrantHits), shaded});
+                }
                 if (covered == 0)
                     continue;
                 layer.coverage[p] = float(covered) / float(kEdgeSamples * kEdgeSamples);

@@ -8,7 +8,9 @@
 // with a corner on a surface is a silhouette or a depth edge and takes 8×8
 // samples for its coverage and mean depth, shaded at one sample per 4×4
 // quadrant (weighted by the quadrant's hits). A surface narrower than a pixel
-// between four corners that all miss it is not drawn.
+// between four corners that all miss it is not drawn. The rays go to Embree
+// as streams (a row's corners, a row's centres, an edge pixel's samples),
+// which find what the same rays alone find, bit for bit.
 //
 // Radiance is Lambertian, lit through the hair:
 //     L = (ρ/π) Σ_l E_l · max(0, n·ω_l) · (V_l + T_s,l),

@@ -13,6 +13,7 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -198,6 +199,47 @@ TEST(SurfaceScene, ABatchOfShadowSegmentsIsEachSegmentAlone) {
     }
     EXPECT_GT(count, 100); // both answers are exercised
     EXPECT_LT(count, 2900);
+}
+
+TEST(SurfaceScene, ABatchOfRaysHitsWhatEachRayAloneHits) {
+    // The batch (Embree's stream of coherent rays) and one ray at a time find
+    // the same hit, bit for bit: camera-like fans of rays through a mannequin
+    // head with normals and a sphere in front of it, from outside and from
+    // inside the head, with and without a bound; misses included.
+    const Sphere cranium{Vec3f(0.0f, 1.0f, 0.0f), 0.1f};
+    const SurfaceScene scene({Sphere{Vec3f(0.05f, 1.0f, 0.2f), 0.03f}},
+                             {generateHeadMesh(cranium, 48)});
+    Pcg32 rng(5);
+    std::vector<Vec3f> origins, dirs;
+    for (int i = 0; i < 4000; ++i) {
+        const bool inside = i % 5 == 0;
+        const Vec3f eye = inside ? cranium.center : Vec3f(0.02f, 1.05f, 0.6f);
+        origins.push_back(eye);
+        const Vec3f toward =
+            inside ? Vec3f(rng.uniform(-1.0f, 1.0f), rng.uniform(-1.0f, 1.0f),
+                           rng.uniform(-1.0f, 1.0f))
+                   : cranium.center +
+                         Vec3f(rng.uniform(-0.2f, 0.2f), rng.uniform(-0.2f, 0.2f), 0.0f) - eye;
+        dirs.push_back(normalizeOr(toward, Vec3f(0, 0, -1)));
+    }
+    int hits = 0;
+    for (const float tMax : {std::numeric_limits<float>::infinity(), 0.55f}) {
+        std::vector<std::optional<SurfaceHit>> batch(origins.size());
+        scene.intersect(origins, dirs, tMax, batch);
+        for (std::size_t i = 0; i < origins.size(); ++i) {
+            const std::optional<SurfaceHit> alone = scene.intersect(origins[i], dirs[i], tMax);
+            ASSERT_EQ(batch[i].has_value(), alone.has_value()) << "ray " << i;
+            if (!alone)
+                continue;
+            ++hits;
+            EXPECT_EQ(batch[i]->t, alone->t) << "ray " << i;
+            EXPECT_EQ(batch[i]->surface, alone->surface) << "ray " << i;
+            EXPECT_EQ(batch[i]->normal, alone->normal) << "ray " << i;
+            EXPECT_EQ(batch[i]->geometricNormal, alone->geometricNormal) << "ray " << i;
+        }
+    }
+    EXPECT_GT(hits, 2000); // hits and misses, sphere and mesh, are exercised
+    EXPECT_LT(hits, 7900);
 }
 
 TEST(SurfaceScene, RaySceneMeetsTheSurfaceBeforeTheFibersBehindIt) {

@@ -52,6 +52,12 @@ public:
 
     /// The nearest surface on origin + t·dir, t ∈ (0, tMax). Thread-safe.
     std::optional<SurfaceHit> intersect(const Vec3f& origin, const Vec3f& dir, float tMax) const;
+    /// intersect() for many rays at once, the meshes traced as one stream of
+    /// rays (Embree's coherent packets: a camera's rays through neighbouring
+    /// pixels): hits[i] = intersect(origins[i], dirs[i], tMax). The three
+    /// spans have the same size. Thread-safe.
+    void intersect(std::span<const Vec3f> origins, std::span<const Vec3f> dirs, float tMax,
+                   std::span<std::optional<SurfaceHit>> hits) const;
     /// Whether a surface lies on origin + t·dir, t ∈ (0, tMax) (a segment
     /// starting inside a sphere does). Thread-safe.
     bool occluded(const Vec3f& origin, const Vec3f& dir, float tMax) const;
