@@ -70,10 +70,13 @@ public:
             return std::strcmp(a.name.c_str(), b.name.c_str()) < 0;
         });
         // Half unless the layer asks for float or a value does not fit (the
-        // tiles not held are zeros; a held tile's pixels outside the image too).
+        // tiles not held read as the fill; a held tile's pixels outside the
+        // image too).
         tbb::parallel_for(std::size_t(0), channels_.size(), [&](std::size_t i) {
             ExrChannel& c = channels_[i];
             const FilmLayer& l = *c.layer;
+            const float fill = l.fill(int(c.channel));
+            c.half = c.half && detail::maxAbs(&fill, 1, 1) <= kHalfMax;
             for (int ty = 0; c.half && ty < l.tilesY(); ++ty)
                 for (int tx = 0; c.half && tx < l.tilesX(); ++tx)
                     if (const float* t = l.tileOrNull(tx, ty))
@@ -109,8 +112,8 @@ public:
                 const ExrChannel& c = channels_[i];
                 std::uint8_t* dst = out + c.offset;
                 const float* src = row.data() + c.channel;
-                if (!held) // +0 as half and as float: zero bytes
-                    std::memset(dst, 0, width * (c.half ? sizeof(std::uint16_t) : sizeof(float)));
+                if (!held)
+                    writeFill(layer->fill(int(c.channel)), c.half, width, dst);
                 else if (c.half)
                     detail::toHalf(src, stride, width, reinterpret_cast<std::uint16_t*>(dst));
                 else
@@ -121,6 +124,21 @@ public:
     }
 
 private:
+    /// `width` copies of `fill` as the file stores it (half or float).
+    static void writeFill(float fill, bool half, std::size_t width, std::uint8_t* dst) {
+        if (isPositiveZero(fill)) { // +0 as half and as float: zero bytes
+            std::memset(dst, 0, width * (half ? sizeof(std::uint16_t) : sizeof(float)));
+        } else if (half) {
+            std::uint16_t bits;
+            detail::toHalf(&fill, 1, 1, &bits);
+            for (std::size_t x = 0; x < width; ++x)
+                std::memcpy(dst + x * sizeof(bits), &bits, sizeof(bits));
+        } else {
+            for (std::size_t x = 0; x < width; ++x)
+                std::memcpy(dst + x * sizeof(float), &fill, sizeof(float));
+        }
+    }
+
     /// A film layer and its channels' places in channels_.
     struct LayerChannels {
         const FilmLayer* layer;

@@ -7,7 +7,8 @@
 
 namespace hairvox {
 
-FilmLayer::FilmLayer(std::string name_, int channels_, bool fullPrecision_, int width, int height)
+FilmLayer::FilmLayer(std::string name_, int channels_, bool fullPrecision_, int width, int height,
+                     Rgb fill)
     : name(std::move(name_))
     , channels(channels_)
     , fullPrecision(fullPrecision_)
@@ -15,16 +16,32 @@ FilmLayer::FilmLayer(std::string name_, int channels_, bool fullPrecision_, int 
     , height_(height)
     , tilesX_((width + kTileSize - 1) / kTileSize)
     , tilesY_((height + kTileSize - 1) / kTileSize)
-    , tiles_(std::size_t(tilesX_) * std::size_t(tilesY_)) {}
+    , tiles_(std::size_t(tilesX_) * std::size_t(tilesY_)) {
+    for (int c = 0; c < std::min(channels, 3); ++c)
+        fill_[std::size_t(c)] = fill[c];
+}
+
+bool FilmLayer::zeroFill() const {
+    return std::all_of(fill_.begin(), fill_.end(), [](float v) { return isPositiveZero(v); });
+}
 
 float* FilmLayer::tile(int tx, int ty) {
     auto& t = tiles_[std::size_t(ty) * std::size_t(tilesX_) + std::size_t(tx)];
     if (!t) {
-        // calloc: zeros without a pass of our own where the allocator hands
-        // out fresh pages.
-        t.reset(static_cast<float*>(std::calloc(tileFloats(), sizeof(float))));
-        if (!t)
-            throw std::bad_alloc();
+        if (zeroFill()) {
+            // calloc: zeros without a pass of our own where the allocator
+            // hands out fresh pages.
+            t.reset(static_cast<float*>(std::calloc(tileFloats(), sizeof(float))));
+            if (!t)
+                throw std::bad_alloc();
+        } else {
+            t.reset(static_cast<float*>(std::malloc(tileFloats() * sizeof(float))));
+            if (!t)
+                throw std::bad_alloc();
+            const auto c = std::size_t(channels);
+            for (std::size_t i = 0; i < tileFloats(); ++i)
+                t[i] = fill_[i % c];
+        }
     }
     return t.get();
 }
@@ -49,16 +66,22 @@ bool FilmLayer::copyRow(int y, float* out) const {
         if (const float* t = tileOrNull(tx, ty))
             std::copy_n(t + offset(x0, y), n, dst);
         else
-            std::fill_n(dst, n, 0.0f);
+            for (std::size_t i = 0; i < n; ++i)
+                dst[i] = fill_[i % c];
     }
     return true;
 }
 
 std::vector<float> FilmLayer::dense() const {
-    const std::size_t row = std::size_t(width_) * std::size_t(channels);
+    const auto c = std::size_t(channels);
+    const std::size_t row = std::size_t(width_) * c;
     std::vector<float> out(row * std::size_t(height_), 0.0f);
-    for (int y = 0; y < height_; ++y)
-        copyRow(y, out.data() + std::size_t(y) * row);
+    for (int y = 0; y < height_; ++y) {
+        float* dst = out.data() + std::size_t(y) * row;
+        if (!copyRow(y, dst))
+            for (std::size_t i = 0; i < row; ++i)
+                dst[i] = fill_[i % c];
+    }
     return out;
 }
 
@@ -72,9 +95,11 @@ void FilmLayer::assign(std::span<const float> values) {
             const int x0 = tx * kTileSize, n = std::min(kTileSize, width_ - x0);
             const auto row = values.subspan(
                 (std::size_t(y) * std::size_t(width_) + std::size_t(x0)) * c, std::size_t(n) * c);
-            // A tile only for what is not zero: what a tile left out reads as.
-            if (!tileOrNull(tx, y / kTileSize) &&
-                std::all_of(row.begin(), row.end(), [](float v) { return isPositiveZero(v); }))
+            // A tile only for what is not the fill: what a tile left out reads as.
+            bool fillOnly = !tileOrNull(tx, y / kTileSize);
+            for (std::size_t i = 0; fillOnly && i < row.size(); ++i)
+                fillOnly = isFill(i % c, row[i]);
+            if (fillOnly)
                 continue;
             std::copy(row.begin(), row.end(), tile(tx, y / kTileSize) + offset(x0, y));
         }
@@ -87,13 +112,13 @@ Film::Film(int width, int height)
         throw std::invalid_argument(strCat("Film: size ", width, " x ", height));
 }
 
-std::size_t Film::addLayer(std::string name, int channels, bool fullPrecision) {
+std::size_t Film::addLayer(std::string name, int channels, bool fullPrecision, Rgb fill) {
     if (channels != 1 && channels != 3)
         throw std::invalid_argument(
             strCat("Film: layer '", name, "' with ", channels, " channels"));
     if (find(name))
         throw std::invalid_argument(strCat("Film: layer '", name, "' added twice"));
-    layers_.emplace_back(std::move(name), channels, fullPrecision, width_, height_);
+    layers_.emplace_back(std::move(name), channels, fullPrecision, width_, height_, fill);
     return layers_.size() - 1;
 }
 

@@ -846,7 +846,8 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
             " segment-tiles behind surfaces, " + thousands(st.segmentTilesSkipped) +
             " segment-tiles opaque");
     more(strCat("film: ", megabytes(r.film.bytesHeld()), " of ", megabytes(r.film.denseBytes()),
-                " MB held (a layer holds no ", Film::kTileSize, "-pixel tile that is all zero)"));
+                " MB held (a layer holds no ", Film::kTileSize,
+                "-pixel tile that is all its fill: zero, or the background)"));
     const std::string rate =
         scene.shadingRate == ShadingRate::Adaptive
             ? strCat("adaptive rate, tolerance ", scene.shadingTolerance, ": ",

@@ -338,8 +338,10 @@ struct PixelState {
 };
 
 /// One tile of a film layer as a raster tile writes it: the film holds the
-/// tile only once a value other than +0 is written (what a tile it does not
-/// hold reads as), so hair layers take no memory where no hair is seen.
+/// tile only once a value other than the layer's fill is written (what a tile
+/// it does not hold reads as: +0, or the background colour for the background
+/// and the beauty), so hair layers take no memory where no hair is seen, nor
+/// the background and the beauty where nothing is.
 class TileOutput {
 public:
     TileOutput(FilmLayer* layer, int tx, int ty)
@@ -351,7 +353,7 @@ public:
     /// Sets channel c of the pixel at `pixel` (its index in the film's tile),
     /// which nothing has written yet; nothing where the layer is not stored.
     void set(std::size_t pixel, std::size_t c, float v) {
-        if (layer_ && !isPositiveZero(v))
+        if (layer_ && !layer_->isFill(c, v))
             values()[pixel * channels_ + c] = v;
     }
     /// Adds v to channel c of the pixel at `pixel`.
@@ -1105,7 +1107,9 @@ RasterOutput rasterize(const Groom& groom, const Camera& camera, const FragmentS
     Film& film = out.film;
     // Each layer's tiles are allocated by the raster tile that writes them
     // (finishCoverage(), finishShading()), where it writes anything but +0.
-    ctx.beautyLayer = film.addLayer(std::string(Film::kBeauty), 3);
+    // Where nothing is seen, the beauty and the background layer are the
+    // background colour: their fill (film.h), as the other layers' is 0.
+    ctx.beautyLayer = film.addLayer(std::string(Film::kBeauty), 3, false, settings.background);
     ctx.alphaLayer = film.addLayer(std::string(Film::kAlpha), 1);
     const std::vector<RasterLayer> layers = rasterLayers(ctx.layout);
     if (settings.layers)
@@ -1115,8 +1119,11 @@ RasterOutput rasterize(const Groom& groom, const Camera& camera, const FragmentS
                 throw InputError(strCat("layer \"", name, "\": not a layer of this render"));
     std::vector<std::size_t> index;
     for (const RasterLayer& l : layers)
-        index.push_back(settings.stores(l.name) ? film.addLayer(l.name, l.channels, l.fullPrecision)
-                                                : kNotStored);
+        index.push_back(
+            settings.stores(l.name)
+                ? film.addLayer(l.name, l.channels, l.fullPrecision,
+                                l.name == kBackgroundLayer ? settings.background : Rgb(0.0f))
+                : kNotStored);
     // rasterLayers()' order: radiance, the rasterizer's four, averages.
     const std::size_t radiance = ctx.layout.radiance.size();
     ctx.radianceLayer.assign(index.begin(), index.begin() + std::ptrdiff_t(radiance));

@@ -147,6 +147,80 @@ TEST(ExrFile, TilesNotHeldWriteAsZeros) {
     EXPECT_EQ(exr.channels.at("Z")[sparse.index(5, 35)], 0.0f);
 }
 
+TEST(Film, ALayersTilesNotHeldReadAsItsFill) {
+    // A background-like layer: its fill is what it reads, allocates and
+    // writes where it holds no tile.
+    const Rgb background(0.05f, 0.06f, 0.07f);
+    Film film(70, 40);
+    FilmLayer& layer = film.layer(film.addLayer("bg", 3, false, background));
+    FilmLayer& scalar = film.layer(film.addLayer("s", 1, false, Rgb(2.0f, 9.0f, 9.0f)));
+    EXPECT_FALSE(layer.zeroFill());
+    EXPECT_EQ(layer.rgb(film.index(69, 39)), background);
+    EXPECT_EQ(layer.value(3, 4, 1), 0.06f);
+    EXPECT_EQ(scalar.value(3, 4), 2.0f);
+    EXPECT_TRUE(layer.isFill(2, 0.07f));
+    EXPECT_FALSE(layer.isFill(2, 0.0f));
+    EXPECT_EQ(layer.tilesHeld(), 0u);
+    // A tile is allocated as the fill, its pixels outside the image too.
+    layer.at(69, 39, 0) = 1.0f;
+    const float* t = layer.tileOrNull(2, 1);
+    ASSERT_NE(t, nullptr);
+    for (std::size_t i = 0; i < FilmLayer::kTilePixels * 3; ++i)
+        EXPECT_EQ(t[i], i == (7 * 32 + 5) * 3 ? 1.0f : background[int(i % 3)]) << i;
+    // Rows and dense(): the fill where no tile is held.
+    std::vector<float> row(70 * 3, -1.0f);
+    EXPECT_FALSE(layer.copyRow(5, row.data()));
+    ASSERT_TRUE(layer.copyRow(39, row.data()));
+    for (std::size_t i = 0; i < row.size(); ++i)
+        EXPECT_EQ(row[i], i == 69 * 3 ? 1.0f : background[int(i % 3)]) << i;
+    const std::vector<float> values = layer.dense();
+    for (std::size_t i = 0; i < values.size(); ++i)
+        ASSERT_EQ(values[i], i == film.index(69, 39) * 3 ? 1.0f : background[int(i % 3)]) << i;
+    // assign() holds only the tiles with a value other than the fill (a +0
+    // is such a value here).
+    Film other(70, 40);
+    FilmLayer& assigned = other.layer(other.addLayer("bg", 3, false, background));
+    std::vector<float> given = values;
+    given[other.index(40, 5) * 3 + 1] = 0.0f; // tile (1, 0)
+    assigned.assign(given);
+    EXPECT_EQ(assigned.tilesHeld(), 2u);
+    EXPECT_NE(assigned.tileOrNull(1, 0), nullptr);
+    EXPECT_NE(assigned.tileOrNull(2, 1), nullptr);
+    EXPECT_EQ(assigned.dense(), given);
+}
+
+TEST(ExrFile, TilesNotHeldWriteAsTheirLayersFill) {
+    // A layer whose fill is a colour, with one tile held, and the same values
+    // in a zero-fill layer holding every tile: the same file, byte for byte,
+    // at every compression; and the fill in half where it fits.
+    const Rgb background(0.05f, 0.06f, 0.07f);
+    Film sparse(70, 40), dense(70, 40);
+    sparse.addLayer(std::string(Film::kBeauty), 3, false, background);
+    dense.addLayer(std::string(Film::kBeauty), 3);
+    sparse.layer(Film::kBeauty).at(40, 5, 0) = 0.5f;
+    FilmLayer& all = dense.layer(Film::kBeauty);
+    for (int y = 0; y < 40; ++y)
+        for (int x = 0; x < 70; ++x)
+            for (int c = 0; c < 3; ++c)
+                all.at(x, y, c) = x == 40 && y == 5 && c == 0 ? 0.5f : background[c];
+    EXPECT_EQ(sparse.layer(Film::kBeauty).tilesHeld(), 1u);
+    test::TempDir dir;
+    const auto bytes = [](const std::filesystem::path& path) {
+        std::ifstream in(path, std::ios::binary);
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    };
+    for (const auto& [compression, name] : kExrCompressionNames.entries) {
+        ExrHeader header;
+        header.compression = compression;
+        writeExr(dir / "sparse.exr", sparse, header);
+        writeExr(dir / "dense.exr", dense, header);
+        EXPECT_EQ(bytes(dir / "sparse.exr"), bytes(dir / "dense.exr")) << name;
+    }
+    const ExrImage exr = readExr(dir / "sparse.exr");
+    EXPECT_EQ(exr.channels.at("R")[sparse.index(40, 5)], 0.5f);
+    EXPECT_NEAR(exr.channels.at("B")[sparse.index(69, 39)], 0.07f, 1e-4f);
+}
+
 TEST(ExrFile, EveryLayerRoundTripsAtItsPrecision) {
     const Film film = randomFilm(37, 23, 5);
     test::TempDir dir;

@@ -10,17 +10,21 @@
 //
 // Storage is sparse, in tiles of kTileSize² pixels (the rasterizer's tiles):
 // a layer holds a tile only once something is written into it, and a tile it
-// does not hold reads as zeros. Most AOVs are zero wherever no hair is seen —
-// on the 1080p head, 80% of the tiles of every hair layer — and a film of
-// dense layers was most of a render's memory (357 of the head's 679 MiB),
-// every byte of it paid at its first touch (docs/DESIGN.md §7, "A sparse
-// film"). Within a tile, pixels are row-major and a pixel's channels
-// interleaved (RGB RGB ...); a tile at the image's right or bottom edge has
-// the full size, its pixels outside the image zero.
+// does not hold reads as the layer's fill — zeros, or a value per channel
+// given when the layer is added (the rasterizer's background and beauty
+// layers: the background colour, what every pixel shows where nothing is
+// seen). Most AOVs are zero wherever no hair is seen — on the 1080p head, 80%
+// of the tiles of every hair layer — and a film of dense layers was most of a
+// render's memory (357 of the head's 679 MiB), every byte of it paid at its
+// first touch (docs/DESIGN.md §7, "A sparse film"). Within a tile, pixels are
+// row-major and a pixel's channels interleaved (RGB RGB ...); a tile at the
+// image's right or bottom edge has the full size, its pixels outside the
+// image the fill.
 #pragma once
 
 #include <hairvox/core/rgb.h>
 
+#include <array>
 #include <bit>
 #include <cstddef>
 #include <cstdint>
@@ -35,8 +39,7 @@
 
 namespace hairvox {
 
-/// Whether v is what a tile a layer does not hold reads as: +0 (−0 and NaN
-/// are values to keep).
+/// Whether v is +0, bit for bit (−0 and NaN are values of their own).
 inline bool isPositiveZero(float v) {
     return std::bit_cast<std::uint32_t>(v) == 0;
 }
@@ -47,7 +50,10 @@ public:
     static constexpr int kTileSize = 32;
     static constexpr std::size_t kTilePixels = std::size_t(kTileSize) * kTileSize;
 
-    FilmLayer(std::string name, int channels, bool fullPrecision, int width, int height);
+    /// `fill`: what each channel reads where no tile is held (the first
+    /// `channels` values; zeros by default).
+    FilmLayer(std::string name, int channels, bool fullPrecision, int width, int height,
+              Rgb fill = Rgb(0.0f));
 
     std::string name;
     int channels = 3; ///< 1 or 3
@@ -60,12 +66,22 @@ public:
     int tilesX() const { return tilesX_; }
     int tilesY() const { return tilesY_; }
 
-    /// Channel c of pixel (x, y); 0 where the tile is not held.
+    /// What channel c reads where no tile is held.
+    float fill(int c = 0) const { return fill_[std::size_t(c)]; }
+    /// Whether v is channel c's fill, bit for bit: what a tile not held
+    /// already reads as (a value written needs no tile).
+    bool isFill(std::size_t c, float v) const {
+        return std::bit_cast<std::uint32_t>(v) == std::bit_cast<std::uint32_t>(fill_[c]);
+    }
+    /// Whether every channel's fill is +0.
+    bool zeroFill() const;
+
+    /// Channel c of pixel (x, y); the fill where the tile is not held.
     float value(int x, int y, int c = 0) const {
         const float* t = tileOrNull(x / kTileSize, y / kTileSize);
-        return t ? t[offset(x, y) + std::size_t(c)] : 0.0f;
+        return t ? t[offset(x, y) + std::size_t(c)] : fill(c);
     }
-    /// Channel c of pixel (x, y), its tile allocated (zeros) if not held.
+    /// Channel c of pixel (x, y), its tile allocated (the fill) if not held.
     float& at(int x, int y, int c = 0) {
         return tile(x / kTileSize, y / kTileSize)[offset(x, y) + std::size_t(c)];
     }
@@ -77,7 +93,7 @@ public:
         const int x = xOf(pixel), y = yOf(pixel);
         const float* t = tileOrNull(x / kTileSize, y / kTileSize);
         if (!t)
-            return Rgb(0.0f);
+            return {fill(0), fill(1), fill(2)};
         const float* p = t + offset(x, y);
         return {p[0], p[1], p[2]};
     }
@@ -87,7 +103,7 @@ public:
     const float* tileOrNull(int tx, int ty) const {
         return tiles_[std::size_t(ty) * std::size_t(tilesX_) + std::size_t(tx)].get();
     }
-    /// Tile (tx, ty)'s values, allocated as zeros on the first call. Calls
+    /// Tile (tx, ty)'s values, allocated as the fill on the first call. Calls
     /// for different tiles may run concurrently; calls for one tile may not.
     float* tile(int tx, int ty);
     /// Tiles held, of tilesX() · tilesY().
@@ -95,8 +111,9 @@ public:
     /// Bytes the held tiles take.
     std::size_t bytesHeld() const { return tilesHeld() * tileFloats() * sizeof(float); }
 
-    /// Row y's width · channels values into `out`, zeros where no tile is
-    /// held; false, and `out` untouched, where the row's tiles are all not held.
+    /// Row y's width · channels values into `out`, the fill where no tile is
+    /// held; false, and `out` untouched, where the row's tiles are all not
+    /// held (the row is the fill).
     bool copyRow(int y, float* out) const;
     /// Every pixel's channels, row-major: width · height · channels values.
     std::vector<float> dense() const;
@@ -118,7 +135,8 @@ private:
     }
 
     int width_ = 0, height_ = 0, tilesX_ = 0, tilesY_ = 0;
-    std::vector<std::unique_ptr<float[], Free>> tiles_; ///< row-major, null: zeros
+    std::array<float, 3> fill_{}; ///< per channel (the first `channels`), the rest 0
+    std::vector<std::unique_ptr<float[], Free>> tiles_; ///< row-major, null: the fill
 };
 
 class Film {
@@ -135,10 +153,11 @@ public:
         return std::size_t(y) * std::size_t(width_) + std::size_t(x);
     }
 
-    /// Adds a layer, zero everywhere and holding no tile, and returns its
-    /// index. std::invalid_argument if the name is taken or channels is not
-    /// 1 or 3.
-    std::size_t addLayer(std::string name, int channels, bool fullPrecision = false);
+    /// Adds a layer, `fill` everywhere (zeros by default; a scalar layer
+    /// takes fill.r) and holding no tile, and returns its index.
+    /// std::invalid_argument if the name is taken or channels is not 1 or 3.
+    std::size_t addLayer(std::string name, int channels, bool fullPrecision = false,
+                         Rgb fill = Rgb(0.0f));
     std::optional<std::size_t> find(std::string_view name) const;
     /// The named layer; std::out_of_range naming it if absent.
     const FilmLayer& layer(std::string_view name) const;
