@@ -126,16 +126,23 @@ public:
 private:
     /// `width` copies of `fill` as the file stores it (half or float).
     static void writeFill(float fill, bool half, std::size_t width, std::uint8_t* dst) {
-        if (isPositiveZero(fill)) { // +0 as half and as float: zero bytes
-            std::memset(dst, 0, width * (half ? sizeof(std::uint16_t) : sizeof(float)));
-        } else if (half) {
+        const std::size_t size = half ? sizeof(std::uint16_t) : sizeof(float);
+        if (isPositiveZero(fill) || width == 0) { // +0 as half and as float: zero bytes
+            std::memset(dst, 0, width * size);
+            return;
+        }
+        if (half) {
             std::uint16_t bits;
             detail::toHalf(&fill, 1, 1, &bits);
-            for (std::size_t x = 0; x < width; ++x)
-                std::memcpy(dst + x * sizeof(bits), &bits, sizeof(bits));
+            std::memcpy(dst, &bits, size);
         } else {
-            for (std::size_t x = 0; x < width; ++x)
-                std::memcpy(dst + x * sizeof(float), &fill, sizeof(float));
+            std::memcpy(dst, &fill, size);
+        }
+        // The first value, then what is written copied after itself.
+        for (std::size_t done = 1; done < width;) {
+            const std::size_t n = std::min(done, width - done);
+            std::memcpy(dst + done * size, dst, n * size);
+            done += n;
         }
     }
 

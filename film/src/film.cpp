@@ -21,6 +21,18 @@ FilmLayer::FilmLayer(std::string name_, int channels_, bool fullPrecision_, int 
         fill_[std::size_t(c)] = fill[c];
 }
 
+void FilmLayer::fillPixels(float* out, std::size_t pixels) const {
+    if (channels == 1) {
+        std::fill_n(out, pixels, fill_[0]);
+        return;
+    }
+    for (std::size_t p = 0; p < pixels; ++p, out += 3) {
+        out[0] = fill_[0];
+        out[1] = fill_[1];
+        out[2] = fill_[2];
+    }
+}
+
 bool FilmLayer::zeroFill() const {
     return std::all_of(fill_.begin(), fill_.end(), [](float v) { return isPositiveZero(v); });
 }
@@ -38,9 +50,7 @@ float* FilmLayer::tile(int tx, int ty) {
             t.reset(static_cast<float*>(std::malloc(tileFloats() * sizeof(float))));
             if (!t)
                 throw std::bad_alloc();
-            const auto c = std::size_t(channels);
-            for (std::size_t i = 0; i < tileFloats(); ++i)
-                t[i] = fill_[i % c];
+            fillPixels(t.get(), kTilePixels);
         }
     }
     return t.get();
@@ -66,8 +76,7 @@ bool FilmLayer::copyRow(int y, float* out) const {
         if (const float* t = tileOrNull(tx, ty))
             std::copy_n(t + offset(x0, y), n, dst);
         else
-            for (std::size_t i = 0; i < n; ++i)
-                dst[i] = fill_[i % c];
+            fillPixels(dst, n / c);
     }
     return true;
 }
@@ -79,8 +88,7 @@ std::vector<float> FilmLayer::dense() const {
     for (int y = 0; y < height_; ++y) {
         float* dst = out.data() + std::size_t(y) * row;
         if (!copyRow(y, dst))
-            for (std::size_t i = 0; i < row; ++i)
-                dst[i] = fill_[i % c];
+            fillPixels(dst, std::size_t(width_));
     }
     return out;
 }

@@ -126,6 +126,8 @@ private:
     };
 
     std::size_t tileFloats() const { return kTilePixels * std::size_t(channels); }
+    /// `pixels` pixels' channels, each the fill, into `out`.
+    void fillPixels(float* out, std::size_t pixels) const;
     int xOf(std::size_t pixel) const { return int(pixel % std::size_t(width_)); }
     int yOf(std::size_t pixel) const { return int(pixel / std::size_t(width_)); }
     /// Channel 0 of pixel (x, y) within its tile.
