@@ -142,6 +142,15 @@ Vec3f windingNormal(const TriangleMesh& mesh, std::uint32_t triangle) {
 
 namespace {
 
+/// A context for a stream of coherent rays (Embree then traces them in
+/// packets): camera rays through neighbouring pixels, shadow rays toward a light.
+RTCIntersectContext coherentContext() {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    return context;
+}
+
 /// The nearest sphere on origin + t·dir before `nearest` (which it lowers to
 /// the hit's t).
 std::optional<SurfaceHit> nearestSphereHit(std::span<const Sphere> spheres, const Vec3f& origin,
@@ -216,9 +225,7 @@ void SurfaceScene::intersect(std::span<const Vec3f> origins, std::span<const Vec
     }
     if (rays.empty())
         return;
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    RTCIntersectContext context = coherentContext();
     rtcIntersect1M(embree_->scene, &context, rays.data(), static_cast<unsigned>(rays.size()),
                    sizeof(RTCRayHit));
     for (std::size_t k = 0; k < rays.size(); ++k) {
@@ -273,8 +280,7 @@ void SurfaceScene::occluded(std::span<const Vec3f> origins, std::span<const Vec3
         std::vector<std::uint32_t> rayOf;
     };
     ThreadScratch<Scratch> scratch;
-    std::vector<RTCRay>& rays = scratch->rays;
-    std::vector<std::uint32_t>& rayOf = scratch->rayOf;
+    auto& [rays, rayOf] = *scratch;
     rays.clear();
     rayOf.clear();
     for (std::size_t i = 0; i < origins.size(); ++i) {
@@ -289,9 +295,7 @@ void SurfaceScene::occluded(std::span<const Vec3f> origins, std::span<const Vec3
     }
     if (rays.empty())
         return;
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    RTCIntersectContext context = coherentContext();
     rtcOccluded1M(embree_->scene, &context, rays.data(), static_cast<unsigned>(rays.size()),
                   sizeof(RTCRay));
     for (std::size_t k = 0; k < rays.size(); ++k)

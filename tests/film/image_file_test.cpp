@@ -27,6 +27,22 @@ namespace {
 
 /// A film of pseudo-random layers: a beauty, an RGB layer, a scalar and a
 /// full-precision scalar (depth-like).
+/// `sparse` and `dense` written to EXR at every compression: the same
+/// bytes. Leaves the last pair in `dir` (sparse.exr, dense.exr).
+void expectTheSameFiles(const Film& sparse, const Film& dense, const std::filesystem::path& dir) {
+    const auto bytes = [](const std::filesystem::path& path) {
+        std::ifstream in(path, std::ios::binary);
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    };
+    for (const auto& [compression, name] : kExrCompressionNames.entries) {
+        ExrHeader header;
+        header.compression = compression;
+        writeExr(dir / "sparse.exr", sparse, header);
+        writeExr(dir / "dense.exr", dense, header);
+        EXPECT_EQ(bytes(dir / "sparse.exr"), bytes(dir / "dense.exr")) << name;
+    }
+}
+
 Film randomFilm(int width, int height, std::uint64_t seed) {
     Film film(width, height);
     Pcg32 rng(seed);
@@ -129,17 +145,7 @@ TEST(ExrFile, TilesNotHeldWriteAsZeros) {
     EXPECT_EQ(sparse.layer("Z").tilesHeld(), 1u);
     EXPECT_EQ(dense.layer(Film::kBeauty).tilesHeld(), 6u);
     test::TempDir dir;
-    const auto bytes = [](const std::filesystem::path& path) {
-        std::ifstream in(path, std::ios::binary);
-        return std::string(std::istreambuf_iterator<char>(in), {});
-    };
-    for (const auto& [compression, name] : kExrCompressionNames.entries) {
-        ExrHeader header;
-        header.compression = compression;
-        writeExr(dir / "sparse.exr", sparse, header);
-        writeExr(dir / "dense.exr", dense, header);
-        EXPECT_EQ(bytes(dir / "sparse.exr"), bytes(dir / "dense.exr")) << name;
-    }
+    expectTheSameFiles(sparse, dense, dir.path());
     const ExrImage exr = readExr(dir / "sparse.exr");
     EXPECT_EQ(exr.channels.at("R")[sparse.index(40, 5)], 0.5f);
     EXPECT_TRUE(std::signbit(exr.channels.at("G")[sparse.index(3, 35)]));
@@ -205,17 +211,7 @@ TEST(ExrFile, TilesNotHeldWriteAsTheirLayersFill) {
                 all.at(x, y, c) = x == 40 && y == 5 && c == 0 ? 0.5f : background[c];
     EXPECT_EQ(sparse.layer(Film::kBeauty).tilesHeld(), 1u);
     test::TempDir dir;
-    const auto bytes = [](const std::filesystem::path& path) {
-        std::ifstream in(path, std::ios::binary);
-        return std::string(std::istreambuf_iterator<char>(in), {});
-    };
-    for (const auto& [compression, name] : kExrCompressionNames.entries) {
-        ExrHeader header;
-        header.compression = compression;
-        writeExr(dir / "sparse.exr", sparse, header);
-        writeExr(dir / "dense.exr", dense, header);
-        EXPECT_EQ(bytes(dir / "sparse.exr"), bytes(dir / "dense.exr")) << name;
-    }
+    expectTheSameFiles(sparse, dense, dir.path());
     const ExrImage exr = readExr(dir / "sparse.exr");
     EXPECT_EQ(exr.channels.at("R")[sparse.index(40, 5)], 0.5f);
     EXPECT_NEAR(exr.channels.at("B")[sparse.index(69, 39)], 0.07f, 1e-4f);
