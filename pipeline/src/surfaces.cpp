@@ -94,6 +94,173 @@ struct ShadingSample {
     ViewSample view;
 };
 
+/// What a row's coverage reads: the surfaces, the camera, and the rays
+/// through the pixel corners (row y's corner x at corners[y · cornerRow + x]).
+struct ViewCorners {
+    const SurfaceScene& surfaces;
+    const Camera& camera;
+    const LargeVector<CornerHit>& corners;
+    std::size_t cornerRow;
+
+    /// Pixel (x, y)'s corners: top left, top right, bottom left, bottom right.
+    std::array<const CornerHit*, 4> of(int x, int y) const {
+        const std::size_t c = std::size_t(y) * cornerRow + std::size_t(x);
+        return {&corners[c], &corners[c + 1], &corners[c + cornerRow], &corners[c + cornerRow + 1]};
+    }
+};
+
+/// A silhouette or depth-edge pixel p = (x, y): 8×8 samples (one stream),
+/// one shaded per 4×4 quadrant and weighted by its share of the pixel's hits;
+/// its coverage and mean depth into `layer` (left 0 where no sample hits).
+void coverEdgePixel(const ViewCorners& view, int x, int y, std::size_t p, SurfaceLayer& layer,
+                    std::vector<ShadingSample>& samples) {
+    struct Scratch {
+        std::vector<Vec2f> rasters;
+        std::vector<ViewSample> views;
+    };
+    ThreadScratch<Scratch> scratch;
+    auto& [rasters, views] = *scratch;
+    rasters.clear();
+    for (int qy = 0; qy < 2; ++qy)
+        for (int qx = 0; qx < 2; ++qx)
+            for (int j = qy * kQuadrant; j < (qy + 1) * kQuadrant; ++j)
+                for (int i = qx * kQuadrant; i < (qx + 1) * kQuadrant; ++i)
+                    rasters.emplace_back(float(x) + (float(i) + 0.5f) / kEdgeSamples,
+                                         float(y) + (float(j) + 0.5f) / kEdgeSamples);
+    views.resize(rasters.size());
+    castViews(view.surfaces, view.camera, rasters, views);
+    int covered = 0;
+    double depthSum = 0;
+    const std::size_t firstShaded = samples.size();
+    for (std::size_t q = 0; q < 4; ++q) {
+        int quadrantHits = 0;
+        ViewSample shaded{};
+        for (std::size_t k = 0; k < kQuadrantSamples; ++k) {
+            const ViewSample& s = views[q * kQuadrantSamples + k];
+            if (s.surface == kMiss)
+                continue;
+            if (quadrantHits++ == 0)
+                shaded = s;
+            depthSum += double(s.depth);
+        }
+        covered += quadrantHits;
+        if (quadrantHits > 0)
+            samples.push_back({p, float(quadrantHits), shaded});
+    }
+    if (covered == 0)
+        return;
+    layer.coverage[p] = float(covered) / float(kEdgeSamples * kEdgeSamples);
+    layer.depth[p] = static_cast<float>(depthSum / covered);
+    for (std::size_t k = firstShaded; k < samples.size(); ++k)
+        samples[k].weight /= float(covered);
+}
+
+/// Row y's coverage and depth per pixel into `layer`, and its points to
+/// shade appended to `samples` in pixel order. A pixel whose four corners
+/// meet one surface at about one depth, and whose centre does too, is
+/// covered and shaded at its centre (the row's centres cast as one stream);
+/// one with any corner on a surface otherwise is an edge pixel.
+void coverRow(const ViewCorners& view, int y, SurfaceLayer& layer,
+              std::vector<ShadingSample>& samples) {
+    struct Scratch {
+        std::vector<std::uint8_t> smooth; ///< per pixel: its centre is cast
+        std::vector<Vec2f> rasters;
+        std::vector<ViewSample> centres;
+    };
+    ThreadScratch<Scratch> scratch;
+    auto& [smooth, rasters, centres] = *scratch;
+    const int width = view.camera.width();
+    smooth.assign(std::size_t(width), 0);
+    rasters.clear();
+    for (int x = 0; x < width; ++x) {
+        const auto c = view.of(x, y);
+        bool oneSurface = c[0]->surface != kMiss;
+        float zMin = std::numeric_limits<float>::infinity(), zMax = 0;
+        for (const CornerHit* h : c) {
+            oneSurface = oneSurface && h->surface == c[0]->surface;
+            zMin = std::min(zMin, h->depth);
+            zMax = std::max(zMax, h->depth);
+        }
+        if (oneSurface && zMax <= kSmoothDepthRatio * zMin) {
+            smooth[std::size_t(x)] = 1;
+            rasters.emplace_back(float(x) + 0.5f, float(y) + 0.5f);
+        }
+    }
+    centres.resize(rasters.size());
+    castViews(view.surfaces, view.camera, rasters, centres);
+    std::size_t centre = 0;
+    for (int x = 0; x < width; ++x) {
+        const std::size_t p = std::size_t(y) * std::size_t(width) + std::size_t(x);
+        const auto c = view.of(x, y);
+        layer.coverage[p] = 0.0f;
+        layer.depth[p] = 0.0f;
+        if (smooth[std::size_t(x)]) {
+            const ViewSample& v = centres[centre++];
+            if (v.surface == c[0]->surface) {
+                layer.coverage[p] = 1.0f;
+                layer.depth[p] = v.depth;
+                samples.push_back({p, 1.0f, v});
+                continue;
+            }
+        } else if (std::none_of(c.begin(), c.end(),
+                                [](const CornerHit* h) { return h->surface != kMiss; })) {
+            continue;
+        }
+        coverEdgePixel(view, x, y, p, layer, samples);
+    }
+}
+
+/// Each sample's Lambertian radiance lit through the hair (surfaces.h),
+/// summed over the lights in order, into `radiance`; the global term is
+/// evaluated kBatch samples at a time per light.
+void lightSamples(std::span<const ShadingSample> samples, const std::vector<Rgb>& albedo,
+                  const std::vector<Light>& lights,
+                  const std::vector<const LightGlobalTerm*>& terms, std::vector<Rgb>& radiance) {
+    struct Scratch {
+        std::vector<GlobalTermQuery> queries;
+        std::vector<std::size_t> which; ///< per query: its sample
+        std::vector<float> cosines;     ///< per query
+        std::vector<GlobalTerm> terms;  ///< per query
+    };
+    ThreadScratch<Scratch> scratch;
+    auto& [queries, which, cosines, g] = *scratch;
+    radiance.assign(samples.size(), Rgb(0.0f));
+    for (std::size_t l = 0; l < lights.size(); ++l) {
+        if (!terms[l])
+            continue;
+        const Light& light = lights[l];
+        for (std::size_t begin = 0; begin < samples.size(); begin += kBatch) {
+            const std::size_t end = std::min(samples.size(), begin + kBatch);
+            queries.clear();
+            which.clear();
+            cosines.clear();
+            for (std::size_t i = begin; i != end; ++i) {
+                const ViewSample& v = samples[i].view;
+                const Vec3f x = v.position + surfaceOffset(v.position) * v.geometricNormal;
+                const Light::Path path = light.pathFrom(x);
+                const float cosTheta = glm::dot(v.normal, path.omega);
+                if (!(cosTheta > 0) || !(glm::dot(v.geometricNormal, path.omega) > 0))
+                    continue;
+                Vec3f across, unused;
+                coordinateSystem(path.omega, across, unused);
+                GlobalTermQuery q{x, across};
+                q.onFiber = false;
+                queries.push_back(q);
+                which.push_back(i);
+                cosines.push_back(cosTheta);
+            }
+            g.resize(queries.size()); // every element written by evaluate
+            terms[l]->evaluate(queries, g);
+            for (std::size_t k = 0; k < queries.size(); ++k) {
+                const std::size_t i = which[k];
+                const float distance = light.pathFrom(queries[k].position).distance;
+                radiance[i] += float(InvPi) * albedo[samples[i].view.surface] *
+                               light.irradiance(distance) * cosines[k] * (Rgb(g[k].V) + g[k].T_s);
+            }
+        }
+    }
+}
+
 } // namespace
 
 SurfaceLayer surfaceLayer(const SurfaceScene& surfaces, const std::vector<Rgb>& albedo,
@@ -137,153 +304,28 @@ SurfaceLayer surfaceLayer(const SurfaceScene& surfaces, const std::vector<Rgb>& 
 
     // 2. A band of rows a task: coverage and depth per pixel, the points to
     // shade (in pixel order), and their Lambertian radiance lit through the
-    // hair, light by light, added into their pixels. A band's points live in
-    // its thread's arrays only: gathered for the whole image they were the
-    // layer's largest memory (Ratboy at 1280²: ~0.7M points of 64 bytes,
-    // held per row, copied into one array, with a radiance each), and on
-    // this VM fresh memory is time (docs/DESIGN.md §7).
+    // hair, added into their pixels. A band's points live in its thread's
+    // arrays only: gathered for the whole image (per row, copied into one
+    // array, with a radiance each) they were the layer's largest memory, and
+    // on this VM fresh memory is time (docs/DESIGN.md §7).
+    const ViewCorners view{surfaces, camera, corners, cornerRow};
     const int bands = (height + kBandRows - 1) / kBandRows;
     tbb::parallel_for(0, bands, [&](int band) {
         throwIfInterrupted();
         struct Scratch {
             std::vector<ShadingSample> samples;
             std::vector<Rgb> radiance; ///< per sample
-            std::vector<GlobalTermQuery> queries;
-            std::vector<std::size_t> which; ///< per query: its sample
-            std::vector<float> cosines;     ///< per query
-            std::vector<GlobalTerm> terms;  ///< per query
-            std::vector<std::uint8_t> smooth; ///< per pixel of a row: its centre is cast
-            std::vector<Vec2f> rasters, edgeRasters;
-            std::vector<ViewSample> views;     ///< the row's smooth pixels' centres
-            std::vector<ViewSample> edgeViews; ///< an edge pixel's 8×8 samples
         };
         ThreadScratch<Scratch> scratch;
-        auto& [samples, radiance, queries, which, cosines, g, smooth, rasters, edgeRasters, views,
-               edgeViews] = *scratch;
+        auto& [samples, radiance] = *scratch;
         samples.clear();
         const int yEnd = std::min(height, (band + 1) * kBandRows);
         for (int y = band * kBandRows; y < yEnd; ++y) {
             std::uninitialized_fill_n(layer.radiance.begin() + std::size_t(y) * std::size_t(width),
                                       width, Rgb(0.0f));
-            const auto cornersOf = [&](int x) {
-                const std::size_t c = std::size_t(y) * cornerRow + std::size_t(x);
-                return std::array<const CornerHit*, 4>{&corners[c], &corners[c + 1],
-                                                       &corners[c + cornerRow],
-                                                       &corners[c + cornerRow + 1]};
-            };
-            // The pixels whose four corners meet one surface at about one
-            // depth: their centres, cast as one stream.
-            smooth.assign(std::size_t(width), 0);
-            rasters.clear();
-            for (int x = 0; x < width; ++x) {
-                const auto c = cornersOf(x);
-                bool oneSurface = c[0]->surface != kMiss;
-                float zMin = std::numeric_limits<float>::infinity(), zMax = 0;
-                for (const CornerHit* h : c) {
-                    oneSurface = oneSurface && h->surface == c[0]->surface;
-                    zMin = std::min(zMin, h->depth);
-                    zMax = std::max(zMax, h->depth);
-                }
-                if (oneSurface && zMax <= kSmoothDepthRatio * zMin) {
-                    smooth[std::size_t(x)] = 1;
-                    rasters.emplace_back(float(x) + 0.5f, float(y) + 0.5f);
-                }
-            }
-            views.resize(rasters.size());
-            castViews(surfaces, camera, rasters, views);
-            std::size_t centre = 0;
-            for (int x = 0; x < width; ++x) {
-                const std::size_t p = std::size_t(y) * std::size_t(width) + std::size_t(x);
-                const auto c = cornersOf(x);
-                layer.coverage[p] = 0.0f;
-                layer.depth[p] = 0.0f;
-                if (smooth[std::size_t(x)]) {
-                    const ViewSample& v = views[centre++];
-                    if (v.surface == c[0]->surface) {
-                        layer.coverage[p] = 1.0f;
-                        layer.depth[p] = v.depth;
-                        samples.push_back({p, 1.0f, v});
-                        continue;
-                    }
-                } else if (std::none_of(c.begin(), c.end(),
-                                        [](const CornerHit* h) { return h->surface != kMiss; })) {
-                    continue;
-                }
-                // A silhouette or a depth edge: 8×8 samples (one stream), one
-                // shaded per 4×4 quadrant.
-                edgeRasters.clear();
-                for (int qy = 0; qy < 2; ++qy)
-                    for (int qx = 0; qx < 2; ++qx)
-                        for (int j = qy * kQuadrant; j < (qy + 1) * kQuadrant; ++j)
-                            for (int i = qx * kQuadrant; i < (qx + 1) * kQuadrant; ++i)
-                                edgeRasters.emplace_back(
-                                    float(x) + (float(i) + 0.5f) / kEdgeSamples,
-                                    float(y) + (float(j) + 0.5f) / kEdgeSamples);
-                edgeViews.resize(edgeRasters.size());
-                castViews(surfaces, camera, edgeRasters, edgeViews);
-                int covered = 0;
-                double depthSum = 0;
-                const std::size_t firstShaded = samples.size();
-                for (std::size_t q = 0; q < 4; ++q) {
-                    int quadrantHits = 0;
-                    ViewSample shaded{};
-                    for (std::size_t k = 0; k < kQuadrantSamples; ++k) {
-                        const ViewSample& s = edgeViews[q * kQuadrantSamples + k];
-                        if (s.surface == kMiss)
-                            continue;
-                        if (quadrantHits++ == 0)
-                            shaded = s;
-                        depthSum += double(s.depth);
-                    }
-                    covered += quadrantHits;
-                    if (quadrantHits > 0)
-                        samples.push_back({p, float(quadrantHits), shaded});
-                }
-                if (covered == 0)
-                    continue;
-                layer.coverage[p] = float(covered) / float(kEdgeSamples * kEdgeSamples);
-                layer.depth[p] = static_cast<float>(depthSum / covered);
-                for (std::size_t k = firstShaded; k < samples.size(); ++k)
-                    samples[k].weight /= float(covered);
-            }
+            coverRow(view, y, layer, samples);
         }
-
-        radiance.assign(samples.size(), Rgb(0.0f));
-        for (std::size_t l = 0; l < lights.size(); ++l) {
-            if (!terms[l])
-                continue;
-            const Light& light = lights[l];
-            for (std::size_t begin = 0; begin < samples.size(); begin += kBatch) {
-                const std::size_t end = std::min(samples.size(), begin + kBatch);
-                queries.clear();
-                which.clear();
-                cosines.clear();
-                for (std::size_t i = begin; i != end; ++i) {
-                    const ViewSample& v = samples[i].view;
-                    const Vec3f x = v.position + surfaceOffset(v.position) * v.geometricNormal;
-                    const Light::Path path = light.pathFrom(x);
-                    const float cosTheta = glm::dot(v.normal, path.omega);
-                    if (!(cosTheta > 0) || !(glm::dot(v.geometricNormal, path.omega) > 0))
-                        continue;
-                    Vec3f across, unused;
-                    coordinateSystem(path.omega, across, unused);
-                    GlobalTermQuery q{x, across};
-                    q.onFiber = false;
-                    queries.push_back(q);
-                    which.push_back(i);
-                    cosines.push_back(cosTheta);
-                }
-                g.resize(queries.size()); // every element written by evaluate
-                terms[l]->evaluate(queries, g);
-                for (std::size_t k = 0; k < queries.size(); ++k) {
-                    const std::size_t i = which[k];
-                    const float distance = light.pathFrom(queries[k].position).distance;
-                    radiance[i] += float(InvPi) * albedo[samples[i].view.surface] *
-                                   light.irradiance(distance) * cosines[k] *
-                                   (Rgb(g[k].V) + g[k].T_s);
-                }
-            }
-        }
+        lightSamples(samples, albedo, lights, terms, radiance);
         for (std::size_t i = 0; i < samples.size(); ++i)
             layer.radiance[samples[i].pixel] += samples[i].weight * radiance[i];
     });
