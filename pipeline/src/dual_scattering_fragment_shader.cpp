@@ -66,7 +66,12 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
         std::vector<std::vector<std::uint32_t>> members; ///< per fiber type: its points
     };
     ThreadScratch<Scratch> scratch;
-    auto& [queries, terms, batches, members] = *scratch;
+    // (References, not a structured binding: Clang 14 does not let the
+    // lambda below capture one.)
+    std::vector<GlobalTermQuery>& queries = scratch->queries;
+    std::vector<GlobalTerm>& terms = scratch->terms;
+    std::vector<ShadeBatch>& batches = scratch->batches;
+    std::vector<std::vector<std::uint32_t>>& members = scratch->members;
     queries.resize(points.size());
     for (std::size_t i = 0; i < points.size(); ++i)
         queries[i] = {points[i].position,

@@ -158,8 +158,11 @@ TEST(Film, ALayersTilesNotHeldReadAsItsFill) {
     // writes where it holds no tile.
     const Rgb background(0.05f, 0.06f, 0.07f);
     Film film(70, 40);
-    FilmLayer& layer = film.layer(film.addLayer("bg", 3, false, background));
-    FilmLayer& scalar = film.layer(film.addLayer("s", 1, false, Rgb(2.0f, 9.0f, 9.0f)));
+    // (Both added before either is referenced: adding a layer moves the others.)
+    film.addLayer("bg", 3, false, background);
+    film.addLayer("s", 1, false, Rgb(2.0f, 9.0f, 9.0f));
+    FilmLayer& layer = film.layer("bg");
+    const FilmLayer& scalar = film.layer("s");
     EXPECT_FALSE(layer.zeroFill());
     EXPECT_EQ(layer.rgb(film.index(69, 39)), background);
     EXPECT_EQ(layer.value(3, 4, 1), 0.06f);

@@ -104,7 +104,11 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates, 
             std::vector<Lanes> samples;
         };
         ThreadScratch<Scratch> scratch;
-        auto& [recorded, runs, samples] = *scratch;
+        // (References, not a structured binding: Clang 14 does not let the
+        // lambda below capture one.)
+        std::vector<BrickVolume::CumulativeSample>& recorded = scratch->recorded;
+        std::vector<Run>& runs = scratch->runs;
+        std::vector<Lanes>& samples = scratch->samples;
         for (std::size_t ti = range.begin(); ti != range.end(); ++ti) {
             runs.clear();
             samples.clear();
