@@ -79,6 +79,19 @@ void castViews(const SurfaceScene& surfaces, const Camera& camera, std::span<con
     }
 }
 
+/// Raster positions and what the camera rays through them meet: a
+/// function's per-thread storage for one stream of rays.
+struct ViewRays {
+    std::vector<Vec2f> rasters;
+    std::vector<ViewSample> views; ///< per raster position, once cast
+
+    /// The rays through `rasters`, traced as one stream, into `views`.
+    void cast(const SurfaceScene& surfaces, const Camera& camera) {
+        views.resize(rasters.size());
+        castViews(surfaces, camera, rasters, views);
+    }
+};
+
 /// What a pixel-corner ray met (8 bytes: one per pixel of the image). No
 /// member initialisers: a LargeVector of them is left unwritten until
 /// the rays fill it.
@@ -114,11 +127,7 @@ struct ViewCorners {
 /// its coverage and mean depth into `layer` (left 0 where no sample hits).
 void coverEdgePixel(const ViewCorners& view, int x, int y, std::size_t p, SurfaceLayer& layer,
                     std::vector<ShadingSample>& samples) {
-    struct Scratch {
-        std::vector<Vec2f> rasters;
-        std::vector<ViewSample> views;
-    };
-    ThreadScratch<Scratch> scratch;
+    ThreadScratch<ViewRays> scratch;
     auto& [rasters, views] = *scratch;
     rasters.clear();
     for (int qy = 0; qy < 2; ++qy)
@@ -127,8 +136,7 @@ void coverEdgePixel(const ViewCorners& view, int x, int y, std::size_t p, Surfac
                 for (int i = qx * kQuadrant; i < (qx + 1) * kQuadrant; ++i)
                     rasters.emplace_back(float(x) + (float(i) + 0.5f) / kEdgeSamples,
                                          float(y) + (float(j) + 0.5f) / kEdgeSamples);
-    views.resize(rasters.size());
-    castViews(view.surfaces, view.camera, rasters, views);
+    scratch->cast(view.surfaces, view.camera);
     int covered = 0;
     double depthSum = 0;
     const std::size_t firstShaded = samples.size();
@@ -162,13 +170,15 @@ void coverEdgePixel(const ViewCorners& view, int x, int y, std::size_t p, Surfac
 /// one with any corner on a surface otherwise is an edge pixel.
 void coverRow(const ViewCorners& view, int y, SurfaceLayer& layer,
               std::vector<ShadingSample>& samples) {
+    // (Its own type: this storage is in use while coverEdgePixel() takes
+    // a ViewRays of the thread's.)
     struct Scratch {
         std::vector<std::uint8_t> smooth; ///< per pixel: its centre is cast
-        std::vector<Vec2f> rasters;
-        std::vector<ViewSample> centres;
+        ViewRays centres;
     };
     ThreadScratch<Scratch> scratch;
-    auto& [smooth, rasters, centres] = *scratch;
+    auto& [smooth, centres] = *scratch;
+    std::vector<Vec2f>& rasters = centres.rasters;
     const int width = view.camera.width();
     smooth.assign(std::size_t(width), 0);
     rasters.clear();
@@ -186,8 +196,7 @@ void coverRow(const ViewCorners& view, int y, SurfaceLayer& layer,
             rasters.emplace_back(float(x) + 0.5f, float(y) + 0.5f);
         }
     }
-    centres.resize(rasters.size());
-    castViews(view.surfaces, view.camera, rasters, centres);
+    centres.cast(view.surfaces, view.camera);
     std::size_t centre = 0;
     for (int x = 0; x < width; ++x) {
         const std::size_t p = std::size_t(y) * std::size_t(width) + std::size_t(x);
@@ -195,7 +204,7 @@ void coverRow(const ViewCorners& view, int y, SurfaceLayer& layer,
         layer.coverage[p] = 0.0f;
         layer.depth[p] = 0.0f;
         if (smooth[std::size_t(x)]) {
-            const ViewSample& v = centres[centre++];
+            const ViewSample& v = centres.views[centre++];
             if (v.surface == c[0]->surface) {
                 layer.coverage[p] = 1.0f;
                 layer.depth[p] = v.depth;
@@ -285,17 +294,12 @@ SurfaceLayer surfaceLayer(const SurfaceScene& surfaces, const std::vector<Rgb>& 
     const std::size_t cornerRow = std::size_t(width) + 1;
     LargeVector<CornerHit> corners(cornerRow * (std::size_t(height) + 1));
     tbb::parallel_for(0, height + 1, [&](int y) {
-        struct Scratch {
-            std::vector<Vec2f> rasters;
-            std::vector<ViewSample> views;
-        };
-        ThreadScratch<Scratch> scratch;
+        ThreadScratch<ViewRays> scratch;
         auto& [rasters, views] = *scratch;
         rasters.clear();
         for (int x = 0; x <= width; ++x)
             rasters.emplace_back(float(x), float(y));
-        views.resize(rasters.size());
-        castViews(surfaces, camera, rasters, views);
+        scratch->cast(surfaces, camera);
         for (int x = 0; x <= width; ++x)
             corners[std::size_t(y) * cornerRow + std::size_t(x)] = {views[std::size_t(x)].surface,
                                                                     views[std::size_t(x)].depth};

@@ -4,12 +4,11 @@
 // The shading path calls its global-term models once per batch of up to
 // 1,024 points (the rasterizer's kShadeBatch), and each call needs arrays of
 // that size (the queries, the samples along the fibers, the shadow segments:
-// tens of KB each). Made
-// afresh per call they are an allocation, a value-initialising write of every
-// element and, whenever the allocator hands out memory not used before, page
-// faults. Kept per thread, the arrays keep their capacity: after the first
-// batches a call neither allocates nor writes what it does not use (the
-// default scene A/B 0.918, docs/DESIGN.md).
+// tens of KB each). Made afresh per call they are an allocation, a
+// value-initialising write of every element and, whenever the allocator hands
+// out memory not used before, page faults. Kept per thread, the arrays keep their capacity: after
+// the first batches a call neither allocates nor writes what it does not use (the default scene A/B
+// 0.918, docs/DESIGN.md).
 //
 // A thread can enter the same function again before the first call returns:
 // the global term runs its own parallel loops, and a thread waiting in one may
