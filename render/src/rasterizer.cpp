@@ -382,7 +382,8 @@ struct TileScratch {
     std::vector<std::uint64_t> keys;     ///< sort keys of `order`
     std::vector<std::uint32_t> strandOf; ///< per local segment
     std::vector<std::uint32_t> pointOf;  ///< per local segment: its root-side point
-    std::vector<Fragment> pending, settling, sorted;
+    std::vector<Fragment> pending, sorted;
+    std::vector<Fragment> settling; ///< as long as the longest pending: settle() counts its part
     std::vector<std::uint32_t> pixelStart, cursor;
     std::vector<PixelState> pixels;
     std::vector<Visible> visible;
@@ -633,27 +634,34 @@ private:
 
     /// Composites, in depth order, every pending fragment nearer than z.
     void settle(float z) {
-        s_.settling.clear();
-        std::size_t kept = 0;
+        // Split without a branch: whether a pending fragment is final is a
+        // coin toss to the branch predictor (on the head each is read 6.4
+        // times, at every step until it settles), so each is written to both
+        // arrays and the count of the one it belongs to advances.
+        if (s_.settling.size() < s_.pending.size())
+            s_.settling.resize(s_.pending.size());
+        std::size_t kept = 0, settling = 0;
         for (const Fragment& f : s_.pending) {
-            if (f.depth < z)
-                s_.settling.push_back(f);
-            else
-                s_.pending[kept++] = f;
+            const bool settles = f.depth < z;
+            s_.settling[settling] = f;
+            s_.pending[kept] = f;
+            settling += settles ? 1 : 0;
+            kept += settles ? 0 : 1;
         }
         s_.pending.resize(kept);
-        if (s_.settling.empty())
+        if (settling == 0)
             return;
+        const std::span<const Fragment> settled(s_.settling.data(), settling);
         // Counting sort by pixel, then insertion sort per pixel by (depth,
         // segment; the head after hair at equal depth): a total order.
         s_.pixelStart.assign(area_ + 1, 0);
-        for (const Fragment& f : s_.settling)
+        for (const Fragment& f : settled)
             ++s_.pixelStart[f.pixel + 1];
         for (std::size_t p = 0; p < area_; ++p)
             s_.pixelStart[p + 1] += s_.pixelStart[p];
-        s_.sorted.resize(s_.settling.size());
+        s_.sorted.resize(settled.size());
         s_.cursor.assign(s_.pixelStart.begin(), s_.pixelStart.end() - 1);
-        for (const Fragment& f : s_.settling)
+        for (const Fragment& f : settled)
             s_.sorted[s_.cursor[f.pixel]++] = f;
         auto before = [](const Fragment& a, const Fragment& b) {
             return a.depth < b.depth || (a.depth == b.depth && a.local < b.local);
