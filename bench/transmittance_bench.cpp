@@ -10,7 +10,7 @@
 //   GridForLight        per-light preparation: rate volume + light-space cache
 //   GridForLightRatboy/voxel_um
 //                       the same on a real groom (data/Ratboy_mohawk.tfx, 11k
-//                       strands, 171k segments) from 2 mm down to 0.5 mm voxels
+//                       strands, 171k segments) from 2 mm down to 0.25 mm voxels
 //                       (issue 16: time and memory linear in active voxels):
 //                       ns_per_voxel and bytes_per_voxel should stay flat;
 //                       grid_bytes_per_voxel is the fiber grid's (OpenVDB)
@@ -112,6 +112,8 @@ BENCHMARK(GridForLightRatboy)
     ->Arg(1000)
     ->Arg(700)
     ->Arg(500)
+    ->Arg(350)
+    ->Arg(250)
     ->ArgName("voxel_um")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()

@@ -131,10 +131,16 @@ TEST(BrickVolume, CumulativeSamplesMatchTheIntegralsUpToThem) {
     const auto lines = testLines(v);
     constexpr float kStep = 0.75f;
     constexpr std::size_t kCount = 160;
+    // Every brick a candidate, in reverse order: the line finds its own and orders them.
+    std::vector<std::uint32_t> bricks(v.volume.brickCount());
+    for (std::size_t b = 0; b < bricks.size(); ++b)
+        bricks[b] = static_cast<std::uint32_t>(bricks.size() - 1 - b);
+    std::vector<BrickVolume::BrickCrossing> crossings;
     std::vector<BrickVolume::CumulativeSample> recorded;
     for (std::size_t i = 0; i < lines.size(); i += 3) {
         const auto& [origin, dir] = lines[i];
-        v.volume.integrateCumulative(origin, dir, 0.0f, kStep, kCount, kNeverOpaque, recorded);
+        v.volume.integrateCumulative(origin, dir, 0.0f, kStep, kCount, kNeverOpaque, bricks,
+                                     crossings, recorded);
         std::size_t r = 0;
         OpticalDepths held; // the value an unrecorded sample holds
         for (std::size_t k = 0; k < kCount; k += 7) {

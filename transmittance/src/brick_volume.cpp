@@ -32,14 +32,18 @@ int valueIndex(int x, int y, int z) {
     return (x * BrickVolume::kSide + y) * BrickVolume::kSide + z;
 }
 
-/// Trilinear interpolation of the 8 cell corners c[dx·4 + dy·2 + dz] at fractions f.
-inline Lanes trilinear(const Lanes* const c[8], const Vec3f& f) {
+/// Trilinear interpolation of a cell's corners at fractions f. The corners
+/// left out are zero, so the sum is the 8-corner sum, bit for bit (adding
+/// w·0 to a non-negative sum leaves it as it is).
+inline Lanes trilinear(const CellCorners& c, const Vec3f& f) {
     const float wx[2] = {1.0f - f.x, f.x}, wy[2] = {1.0f - f.y, f.y}, wz[2] = {1.0f - f.z, f.z};
     Lanes r;
-    for (int k = 0; k < 8; ++k) {
+    for (int i = 0; i < c.count; ++i) {
+        const int k = c.k[std::size_t(i)];
         const float w = wx[k >> 2] * wy[(k >> 1) & 1] * wz[k & 1];
+        const Lanes& v = *c.value[std::size_t(i)];
         for (int lane = 0; lane < 8; ++lane)
-            r.v[lane] += w * c[k]->v[lane];
+            r.v[lane] += w * v.v[lane];
     }
     return r;
 }
@@ -79,8 +83,6 @@ bool boxBitSet(const std::vector<std::uint64_t>& bits, const glm::ivec3& c, cons
 }
 
 } // namespace
-
-const Lanes BrickVolume::kZero{};
 
 BrickVolume::BrickVolume(double voxelSize)
     : h_(voxelSize)
@@ -310,6 +312,20 @@ void BrickVolume::set(const BrickSet& bricks, const glm::ivec3& local, const Opt
     });
 }
 
+CellCorners BrickVolume::cornersOf(std::size_t brick, const glm::ivec3& cell) const {
+    CellCorners corners;
+    for (int k = 0; k < 8; ++k) {
+        const std::size_t i = valueAt(brick, valueIndex(cell.x + (k >> 2), cell.y + ((k >> 1) & 1),
+                                                        cell.z + (k & 1)));
+        if (i == kNoValue)
+            continue;
+        const auto n = std::size_t(corners.count++);
+        corners.k[n] = static_cast<std::uint8_t>(k);
+        corners.value[n] = &values_[i];
+    }
+    return corners;
+}
+
 template <typename F>
 void BrickVolume::walkBricks(const Vec3f& O, const Vec3f& dir, float s0, float s1,
                              F&& visit) const {
@@ -364,13 +380,10 @@ void BrickVolume::forEachPiece(std::size_t brick, const glm::ivec3& b, const Gri
                           haveStart = true;
                           return true;
                       }
-                      const Lanes* corner[8];
+                      const CellCorners corners = cornersOf(brick, l);
                       bool any = false;
-                      for (int k = 0; k < 8; ++k) {
-                          corner[k] = &value(brick, valueIndex(l.x + (k >> 2),
-                                                               l.y + ((k >> 1) & 1), l.z + (k & 1)));
-                          any = any || corner[k]->v[0] != 0.0f;
-                      }
+                      for (int i = 0; i < corners.count; ++i)
+                          any = any || corners.value[std::size_t(i)]->v[0] != 0.0f;
                       if (!any) {
                           fStart = Lanes{};
                           haveStart = true;
@@ -378,7 +391,7 @@ void BrickVolume::forEachPiece(std::size_t brick, const glm::ivec3& b, const Gri
                       }
                       const Vec3f cf(cell);
                       const auto at = [&](float t) {
-                          return trilinear(corner, line.at(t) - cf);
+                          return trilinear(corners, line.at(t) - cf);
                       };
                       if (!haveStart)
                           fStart = at(s);
@@ -421,6 +434,8 @@ OpticalDepths BrickVolume::integrate(const Vec3f& origin, const Vec3f& dir, floa
 
 void BrickVolume::integrateCumulative(const Vec3f& origin, const Vec3f& dir, float tStart,
                                       float step, std::size_t count, float opaqueDepth,
+                                      std::span<const std::uint32_t> candidates,
+                                      std::vector<BrickCrossing>& crossings,
                                       std::vector<CumulativeSample>& out) const {
     out.clear();
     if (count == 0)
@@ -457,40 +472,77 @@ void BrickVolume::integrateCumulative(const Vec3f& origin, const Vec3f& dir, flo
             ++k;
         next = std::max(next, k);
     };
-    bool opaque = false;
+    // The candidates the line crosses over [sStart, position(count − 1)], in
+    // order along it (bricks are disjoint: their crossings do not overlap).
     const GridLine<float> line(O, dir);
-    walkBricks(O, dir, sStart, position(count - 1),
-               [&](std::size_t brick, const glm::ivec3& b, float s, float sExit) {
-                   // A brick the line crosses no value's cell of leaves the
-                   // sum and what is recorded as they were (the samples it
-                   // would record repeat the last value; the next brick's
-                   // skipTo records the same ones either side of a change).
-                   float sa, sb;
-                   if (!valueSpan(brick, b, line, s, sExit, sa, sb))
-                       return true;
-                   skipTo(sa);
-                   recordUpTo(sa);
-                   // Pieces end at sample positions, where the running sum is recorded.
-                   forEachPiece(
-                       brick, b, line, sa, sb,
-                       [&](float t) {
-                           const float k = std::floor((t - sStart) / sStep) + 1.0f;
-                           const float split = sStart + k * sStep;
-                           return split > t ? split : split + sStep; // rounding at a sample
-                       },
-                       [&](float s0, float s1, const Lanes& f0, const Lanes& fm, const Lanes& f1) {
-                           // The samples up to the piece hold the sum before it:
-                           // those between the brick's entry and its first cell
-                           // with values are recorded here, not after it.
-                           recordUpTo(s0);
-                           addSimpson(sum, f0, fm, f1, (s1 - s0) / 6.0f);
-                           recordUpTo(s1);
-                       });
-                   opaque = sum.opaque(opaqueSum);
-                   return !opaque;
-               });
-    if (!opaque && next < count)
+    crossings.clear();
+    for (const std::uint32_t brick : candidates) {
+        const Vec3f lo(kBrick * brickCoord_[brick]), hi = lo + float(kBrick);
+        float s0 = sStart, s1 = position(count - 1);
+        for (int a = 0; a < 3; ++a) {
+            if (line.invDir[a] == 0.0f) {
+                // Parallel to the slab: inside it or not at all. On a face
+                // between two bricks, in the upper one only (⌊x⌋, as a
+                // walk through the cells takes it).
+                if (O[a] < lo[a] || O[a] >= hi[a])
+                    s1 = -kInfinity;
+                continue;
+            }
+            const float ta = (lo[a] - O[a]) * line.invDir[a], tb = (hi[a] - O[a]) * line.invDir[a];
+            s0 = std::max(s0, std::min(ta, tb));
+            s1 = std::min(s1, std::max(ta, tb));
+        }
+        if (s0 < s1)
+            crossings.push_back({s0, s1, brick});
+    }
+    std::sort(crossings.begin(), crossings.end(), [](const BrickCrossing& x, const BrickCrossing& y) {
+        return x.sEnter < y.sEnter || (x.sEnter == y.sEnter && x.brick < y.brick);
+    });
+    for (const BrickCrossing& crossing : crossings) {
+        // A brick the line crosses no value's cell of leaves the sum and
+        // what is recorded as they were (the samples it would record repeat
+        // the last value; the next brick's skipTo records the same ones
+        // either side of a change).
+        const glm::ivec3& b = brickCoord_[crossing.brick];
+        float sa, sb;
+        if (!valueSpan(crossing.brick, b, line, crossing.sEnter, crossing.sExit, sa, sb))
+            continue;
+        skipTo(sa);
+        recordUpTo(sa);
+        // Pieces end at sample positions, where the running sum is recorded.
+        forEachPiece(
+            crossing.brick, b, line, sa, sb,
+            [&](float t) {
+                const float k = std::floor((t - sStart) / sStep) + 1.0f;
+                const float split = sStart + k * sStep;
+                return split > t ? split : split + sStep; // rounding at a sample
+            },
+            [&](float s0, float s1, const Lanes& f0, const Lanes& fm, const Lanes& f1) {
+                // The samples up to the piece hold the sum before it:
+                // those between the brick's entry and its first cell
+                // with values are recorded here, not after it.
+                recordUpTo(s0);
+                addSimpson(sum, f0, fm, f1, (s1 - s0) / 6.0f);
+                recordUpTo(s1);
+            });
+        if (sum.opaque(opaqueSum))
+            return; // later samples would only grow
+    }
+    if (next < count)
         recordNext(); // the first sample after the last brick: the final value
+}
+
+Bounds3f BrickVolume::valueBounds(std::size_t brick) const {
+    Bounds3f bounds;
+    const glm::ivec3 base = kBrick * brickCoord_[brick];
+    const float h = static_cast<float>(h_);
+    for (const CellBox& box : cellBoxes_[brick].box) {
+        if (box.lo[0] > box.hi[0])
+            continue; // an octant without such cells
+        bounds.extend(Vec3f(base + glm::ivec3(box.lo[0], box.lo[1], box.lo[2])) * h);
+        bounds.extend(Vec3f(base + glm::ivec3(box.hi[0], box.hi[1], box.hi[2]) + 1) * h);
+    }
+    return bounds;
 }
 
 OpticalDepths BrickVolume::sample(const Vec3f& position) const {
@@ -501,11 +553,7 @@ OpticalDepths BrickVolume::sample(const Vec3f& position) const {
     if (brick < 0)
         return {};
     const glm::ivec3 l = c - kBrick * b;
-    const Lanes* corner[8];
-    for (int k = 0; k < 8; ++k)
-        corner[k] = &value(static_cast<std::size_t>(brick),
-                           valueIndex(l.x + (k >> 2), l.y + ((k >> 1) & 1), l.z + (k & 1)));
-    return trilinear(corner, q - Vec3f(c)).depths();
+    return trilinear(cornersOf(static_cast<std::size_t>(brick), l), q - Vec3f(c)).depths();
 }
 
 Bounds3f BrickVolume::bounds() const {

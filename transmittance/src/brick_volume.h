@@ -17,11 +17,14 @@
 // sizes a strand crosses a brick alone and fills ~5% of it (Ratboy at 0.5 mm:
 // 25 active voxels per 8³ brick), where dense 9³ bricks cost 0.9 KB per active
 // voxel and grew as the square of the resolution, and a 16-bit index per slot
-// still cost 1.46 KB a brick. A line's walk skips empty space a super-brick
-// (4³ bricks) at a time, and passes a brick without walking its cells where
-// it misses the boxes of the cells that hold a value in each of the brick's
-// octants (at 0.5 mm, 75% of the bricks a lattice line enters on Ratboy),
-// and walks the others only across the boxes it meets.
+// still cost 1.46 KB a brick. A line passes a brick without walking its cells
+// where it misses the boxes of the cells that hold a value in each of the
+// brick's octants, and walks the others only across the boxes it meets. Which
+// bricks a line visits: a march (integrate) walks every brick it passes,
+// skipping empty space a super-brick (4³ bricks) at a time; the light cache's
+// lattice lines (integrateCumulative) are given the bricks whose values can
+// reach them, binned by brick rather than found by walking (at 0.5 mm on
+// Ratboy a lattice line passed 4 bricks for each whose values it met).
 #pragma once
 
 #include <hairvox/core/grid_traversal.h>
@@ -69,6 +72,15 @@ struct alignas(32) Lanes {
     OpticalDepths depths() const {
         return {v[0], Rgb(v[1], v[2], v[3]), Rgb(v[4], v[5], v[6])};
     }
+};
+
+/// The corners of a cell that hold a value: at fine voxels a strand crosses a
+/// brick alone, and a cell a lattice line walks has ~2 of its 8 (the others
+/// read zero and add nothing to an interpolation).
+struct CellCorners {
+    int count = 0;
+    std::array<std::uint8_t, 8> k;          ///< corner dx·4 + dy·2 + dz
+    std::array<const Lanes*, 8> value;
 };
 
 class BrickVolume {
@@ -124,16 +136,32 @@ public:
         std::size_t k;
         Lanes value;
     };
+    /// Where a line crosses a brick (index space: s = t / voxel size).
+    struct BrickCrossing {
+        float sEnter, sExit;
+        std::uint32_t brick;
+    };
+    /// World-space box of the cells of brick `brick` that a value is a corner
+    /// of (empty where it has none): a line that misses it adds nothing there.
+    Bounds3f valueBounds(std::size_t brick) const;
     /// Cumulative integrals along origin + t·dir at t_k = tStart + k·step,
     /// k = 0 .. count − 1, recorded sparsely: `out` gets, in increasing k, the
     /// samples from the last one before the line enters a brick whose values
     /// it meets to the last one before it leaves it. A sample not recorded holds the value of the
     /// one recorded before it (the integral does not change outside bricks),
     /// and 0 before the first. Stops once n and every channel of tauP exceed
-    /// `opaqueDepth` (later samples would only grow). Work and output follow
-    /// the bricks the line crosses, not its length.
+    /// `opaqueDepth` (later samples would only grow).
+    ///
+    /// The line visits only `candidates`, in any order: they must include
+    /// every brick whose valueBounds() it meets (others are passed at the cost
+    /// of a slab test). A caller that bins the bricks by the lines their
+    /// values reach — the light cache — makes the work follow the hair the
+    /// line crosses, not the bricks it passes on the way; `crossings` is the
+    /// caller's scratch.
     void integrateCumulative(const Vec3f& origin, const Vec3f& dir, float tStart, float step,
                              std::size_t count, float opaqueDepth,
+                             std::span<const std::uint32_t> candidates,
+                             std::vector<BrickCrossing>& crossings,
                              std::vector<CumulativeSample>& out) const;
 
     /// The trilinear value at a world position (zero outside every brick).
@@ -167,6 +195,8 @@ private:
     /// crosses in a brick.
     bool valueSpan(std::size_t brick, const glm::ivec3& b, const GridLine<float>& line, float s0,
                    float s1, float& sa, float& sb) const;
+    /// The corners holding a value of the cell at `cell` ∈ [0, 8)³ of brick `brick`.
+    CellCorners cornersOf(std::size_t brick, const glm::ivec3& cell) const;
     /// Index of the brick at brick coordinate b, or −1.
     std::int64_t find(const glm::ivec3& b) const;
     /// Whether brick b exists, from the occupancy bits (no hashing): what a
@@ -189,15 +219,8 @@ private:
                                   std::size_t(std::popcount(word & (bit - 1)))
                             : kNoValue;
     }
-    /// The value in slot `slot` of brick `brick` (zero when the slot is absent).
-    const Lanes& value(std::size_t brick, int slot) const {
-        const std::size_t i = valueAt(brick, slot);
-        return i == kNoValue ? kZero : values_[i];
-    }
-
     static constexpr std::size_t kNoValue = ~std::size_t(0);
 
-    static const Lanes kZero;
     /// 64-bit words of a brick's slot bitmap.
     static constexpr int kSlotWords = (kBrickValues + 63) / 64;
     /// Which of a brick's kBrickValues slots hold a value, and the values

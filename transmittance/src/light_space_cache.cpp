@@ -89,16 +89,75 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates, 
     const auto samplesPerLine =
         static_cast<std::size_t>(std::ceil((sMaxWorld - cache.sBase_) / cache.h_)) + 2;
 
+    // The lines each brick's values can reach: the lattice rectangle of its
+    // value box's corners, widened by a quarter of a line against rounding
+    // (the box is exact: its cells hold every value). Binned by tile of
+    // lines, then by line within a tile's task, so that a line visits the
+    // bricks whose values it may meet and no other: walking the lattice line
+    // through every brick it passes cost a test per brick, and at fine
+    // voxels the lines (∝ 1/h² over the hair's projection) pass bricks
+    // (∝ 1/h each) far faster than the hair's voxels grow (∝ 1/h).
+    cache.tilesPerRow_ = static_cast<std::size_t>((cache.ni_ + kTile - 1) / kTile);
+    const std::size_t tileRows = static_cast<std::size_t>((cache.nj_ + kTile - 1) / kTile);
+    const std::size_t tileCount = cache.tilesPerRow_ * tileRows;
+    struct LineRect {
+        int i0 = 0, i1 = -1, j0 = 0, j1 = -1; ///< lines [i0, i1] × [j0, j1]; empty if i0 > i1
+    };
+    std::vector<LineRect> reach(rates.brickCount());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, reach.size()), [&](const auto& range) {
+        constexpr float kMargin = 0.25f; // of a line
+        for (std::size_t brick = range.begin(); brick != range.end(); ++brick) {
+            const Bounds3f box = rates.valueBounds(brick);
+            if (box.empty())
+                continue;
+            float u0 = std::numeric_limits<float>::infinity(), u1 = -u0, v0 = u0, v1 = u1;
+            for (const Vec3f& c : corners(box)) {
+                const Vec3f l = cache.toLattice(c);
+                u0 = std::min(u0, l.x);
+                u1 = std::max(u1, l.x);
+                v0 = std::min(v0, l.y);
+                v1 = std::max(v1, l.y);
+            }
+            LineRect& r = reach[brick];
+            r.i0 = std::max(static_cast<int>(std::ceil(u0 - kMargin)), 0);
+            r.i1 = std::min(static_cast<int>(std::floor(u1 + kMargin)), cache.ni_ - 1);
+            r.j0 = std::max(static_cast<int>(std::ceil(v0 - kMargin)), 0);
+            r.j1 = std::min(static_cast<int>(std::floor(v1 + kMargin)), cache.nj_ - 1);
+            if (r.j0 > r.j1)
+                r.i1 = r.i0 - 1;
+        }
+    });
+    // Each tile's bricks, in brick order (a counting sort: deterministic).
+    std::vector<std::size_t> tileStart(tileCount + 1, 0);
+    const auto forEachTileOf = [&](const LineRect& r, auto&& f) {
+        if (r.i0 > r.i1)
+            return;
+        for (int tj = r.j0 / kTile; tj <= r.j1 / kTile; ++tj)
+            for (int ti = r.i0 / kTile; ti <= r.i1 / kTile; ++ti)
+                f(static_cast<std::size_t>(tj) * cache.tilesPerRow_ + static_cast<std::size_t>(ti));
+    };
+    for (const LineRect& r : reach)
+        forEachTileOf(r, [&](std::size_t tile) { ++tileStart[tile + 1]; });
+    for (std::size_t t = 0; t < tileCount; ++t)
+        tileStart[t + 1] += tileStart[t];
+    std::vector<std::uint32_t> tileBricks(tileStart[tileCount]);
+    {
+        std::vector<std::size_t> cursor(tileStart.begin(), tileStart.end() - 1);
+        for (std::size_t brick = 0; brick < reach.size(); ++brick)
+            forEachTileOf(reach[brick], [&](std::size_t tile) {
+                tileBricks[cursor[tile]++] = static_cast<std::uint32_t>(brick);
+            });
+    }
+
     // Lines are integrated a tile a task. A task gathers a tile's runs and
     // samples in its own arrays (reused from tile to tile, so they stay in
     // cache) and stores them at their size.
-    cache.tilesPerRow_ = static_cast<std::size_t>((cache.ni_ + kTile - 1) / kTile);
-    const std::size_t tileCount =
-        cache.tilesPerRow_ * static_cast<std::size_t>((cache.nj_ + kTile - 1) / kTile);
     cache.lineRuns_.resize(tileCount * (kLinesPerTile + 1)); // every entry written below
     cache.tiles_.resize(tileCount);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tileCount), [&](const auto& range) {
         struct Scratch {
+            std::vector<std::uint32_t> lineStart, lineBricks; ///< per line of the tile, its bricks
+            std::vector<BrickVolume::BrickCrossing> crossings;
             std::vector<BrickVolume::CumulativeSample> recorded;
             std::vector<Run> runs;
             std::vector<Lanes> samples;
@@ -106,6 +165,8 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates, 
         ThreadScratch<Scratch> scratch;
         // (References, not a structured binding: Clang 14 does not let the
         // lambda below capture one.)
+        std::vector<std::uint32_t>& lineStart = scratch->lineStart;
+        std::vector<std::uint32_t>& lineBricks = scratch->lineBricks;
         std::vector<BrickVolume::CumulativeSample>& recorded = scratch->recorded;
         std::vector<Run>& runs = scratch->runs;
         std::vector<Lanes>& samples = scratch->samples;
@@ -115,16 +176,37 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates, 
             std::uint32_t* lineRuns = cache.lineRuns_.data() + ti * (kLinesPerTile + 1);
             const int tileI = static_cast<int>(ti % cache.tilesPerRow_) * kTile;
             const int tileJ = static_cast<int>(ti / cache.tilesPerRow_) * kTile;
+            // The tile's bricks by line (a counting sort over the lines they reach).
+            const std::span<const std::uint32_t> bricks(tileBricks.data() + tileStart[ti],
+                                                        tileStart[ti + 1] - tileStart[ti]);
+            const auto forEachLineOf = [&](std::uint32_t brick, auto&& f) {
+                const LineRect& r = reach[brick];
+                for (int j = std::max(r.j0, tileJ); j <= std::min(r.j1, tileJ + kTile - 1); ++j)
+                    for (int i = std::max(r.i0, tileI); i <= std::min(r.i1, tileI + kTile - 1); ++i)
+                        f(static_cast<std::size_t>(j - tileJ) * kTile +
+                          static_cast<std::size_t>(i - tileI));
+            };
+            lineStart.assign(kLinesPerTile + 1, 0);
+            for (const std::uint32_t brick : bricks)
+                forEachLineOf(brick, [&](std::size_t l) { ++lineStart[l + 1]; });
+            for (std::size_t l = 0; l < kLinesPerTile; ++l)
+                lineStart[l + 1] += lineStart[l];
+            lineBricks.resize(lineStart[kLinesPerTile]);
+            for (const std::uint32_t brick : bricks)
+                forEachLineOf(brick, [&](std::size_t l) { lineBricks[lineStart[l]++] = brick; });
+            // (Each lineStart[l] now holds line l's end, the start of line l + 1.)
             for (std::size_t l = 0; l < kLinesPerTile; ++l) {
                 lineRuns[l] = static_cast<std::uint32_t>(runs.size());
+                const std::uint32_t begin = l == 0 ? 0 : lineStart[l - 1], end = lineStart[l];
+                if (begin == end)
+                    continue; // no value reaches the line (or padding): it stores nothing
                 const int li = tileI + static_cast<int>(l % kTile);
                 const int lj = tileJ + static_cast<int>(l / kTile);
-                if (li >= cache.ni_ || lj >= cache.nj_)
-                    continue; // padding
                 Vec3f dir;
                 const Vec3f origin = cache.lineOrigin(li, lj, dir);
                 rates.integrateCumulative(origin, dir, 0.0f, cache.h_, samplesPerLine, opaqueDepth,
-                                          recorded);
+                                          std::span(lineBricks.data() + begin, end - begin),
+                                          scratch->crossings, recorded);
                 // Keep the samples at either end of a step where the value changes
                 // (consecutive k); every other sample equals the one kept before it.
                 const auto changes = [&](std::size_t i) {
