@@ -9,8 +9,8 @@ and writes
 
     OUT_DIR/runtime_vs_error.png   end-to-end time against image error, per scene,
                                    with each scene's Pareto front
-    OUT_DIR/scaling.png            stage times against segment count and image size,
-                                   with the fitted power laws
+    OUT_DIR/scaling.png            stage times against segment count, image size and
+                                   active voxels, with the fitted power laws
 
 The benchmark (bench/sweep) calls it after writing the CSV files; it can be
 rerun by hand on a results directory. Only reads the CSVs: every number is the
@@ -29,7 +29,12 @@ MARKERS = {"exact": "o", "grid": "s", "approx": "^"}
 # Marker fill per shading rate: fragment solid, adaptive pale, vertex hollow.
 FILL = {"fragment": 1.0, "adaptive": 0.3, "vertex": 0.0}
 STAGES = [("total", "total_s"), ("voxelize", "voxelize_s"), ("global term", "global_term_s"),
-          ("raster+shade", None)]
+          ("lights' preparation", "global_term_prepare_s"), ("raster+shade", None)]
+# Scaling kinds: (sweep, x axis label, title, size of a row).
+SCALING = [("segments", "segments", "segment count", lambda r: number(r, "segments")),
+           ("pixels", "pixels", "image size", lambda r: number(r, "width") * number(r, "height")),
+           ("voxels", "active voxels", "active voxels (one groom, finer voxels)",
+            lambda r: number(r, "active_voxels"))]
 
 
 def number(row, key):
@@ -117,14 +122,13 @@ def plot_runtime_vs_error(rows, path):
 
 
 def plot_scaling(rows, fits, path):
-    kinds = [k for k in ("segments", "pixels") if any(r["sweep"] == k for r in rows)]
+    kinds = [k for k in SCALING if any(r["sweep"] == k[0] for r in rows)]
     if not kinds:
         return False
     fig, axes = plt.subplots(1, len(kinds), figsize=(7 * len(kinds), 5.2), dpi=120, squeeze=False)
-    for ax, kind in zip(axes[0], kinds):
+    for ax, (kind, xlabel, title, size) in zip(axes[0], kinds):
         series = [r for r in rows if r["sweep"] == kind]
-        x = [number(r, "segments") if kind == "segments"
-             else number(r, "width") * number(r, "height") for r in series]
+        x = [size(r) for r in series]
         for name, column in STAGES:
             y = [number(r, column) if column else number(r, "raster_s") + number(r, "shade_s")
                  for r in series]
@@ -137,9 +141,9 @@ def plot_scaling(rows, fits, path):
                 ax.plot([lo, hi], [c * lo ** k, c * hi ** k], color=points.get_color(), lw=1)
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_xlabel("segments" if kind == "segments" else "pixels")
+        ax.set_xlabel(xlabel)
         ax.set_ylabel("seconds")
-        ax.set_title("time against " + ("segment count" if kind == "segments" else "image size"))
+        ax.set_title("time against " + title)
         ax.grid(True, which="both", color="#e4e4e4", lw=0.6)
         ax.legend(fontsize=8, title="lines: cost = c·size^k")
     fig.tight_layout()

@@ -84,6 +84,7 @@ void runBench(const BenchOptions& opt) {
     if (opt.noScaling) {
         sweep.segmentScaling.clear();
         sweep.pixelScaling.clear();
+        sweep.voxelScaling.clear();
     }
     if (opt.runs)
         sweep.runs = *opt.runs;

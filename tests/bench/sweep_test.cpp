@@ -141,6 +141,11 @@ TEST(BenchSweep, TinySweepWritesTablesAndPlots) {
         s.width = s.height = size;
         o.pixelScaling.push_back(s);
     }
+    for (const double h : {0.024, 0.012}) {
+        BenchScene s = sceneFile(strCat("tiny ", h * 1e3, " mm"), scene);
+        s.voxelSize = h;
+        o.voxelScaling.push_back(s);
+    }
     o.model.scenes = {sceneFile("tiny", scene).atWidth(32)};
     o.model.melanins = {{"blond", 0.3f}, {"dark", 3.0f}};
     o.model.modes = {GlobalTermMode::Exact, GlobalTermMode::Grid};
@@ -150,10 +155,10 @@ TEST(BenchSweep, TinySweepWritesTablesAndPlots) {
     const SweepResult result = runSweep(o);
 
     // 1 reference + 3 rates × (1 exact + 2 grid + 2 approx) + 2 melanins × (1
-    // path reference + 2 modes) + 2 + 2 scaling rows.
-    ASSERT_EQ(result.rows.size(), 26u);
+    // path reference + 2 modes) + 2 + 2 + 2 scaling rows.
+    ASSERT_EQ(result.rows.size(), 28u);
     const auto csv = readCsv(o.outDir / "results.csv");
-    ASSERT_EQ(csv.size(), 27u);
+    ASSERT_EQ(csv.size(), 29u);
     ASSERT_EQ(csv[0].size(), kBenchCsvColumns.size());
     for (std::size_t i = 0; i < kBenchCsvColumns.size(); ++i)
         EXPECT_EQ(csv[0][i], kBenchCsvColumns[i]);
@@ -190,6 +195,13 @@ TEST(BenchSweep, TinySweepWritesTablesAndPlots) {
                       std::stod(csv[r][column("rel_l1")]))
                 << r;
         }
+        if (csv[r][column("sweep")] == "voxels") {
+            // Grid mode: the lights' preparation is timed, and is part of the global term.
+            EXPECT_GT(std::stod(csv[r][column("global_term_prepare_s")]), 0.0) << r;
+            EXPECT_LE(std::stod(csv[r][column("global_term_prepare_s")]),
+                      std::stod(csv[r][column("global_term_s")]))
+                << r;
+        }
         if (pathReference) {
             EXPECT_EQ(csv[r][column("spp")], "8") << r;
             EXPECT_GT(std::stod(csv[r][column("rays_per_s")]), 0.0) << r;
@@ -200,9 +212,15 @@ TEST(BenchSweep, TinySweepWritesTablesAndPlots) {
     EXPECT_EQ(csv[1][column("rays")], "2");
     EXPECT_NEAR(std::stod(csv[1][column("voxel_size")]), 0.012, 1e-6) << "h0 is the scene's voxel";
 
-    ASSERT_EQ(result.fits.size(), 2u);
+    ASSERT_EQ(result.fits.size(), 3u);
+    EXPECT_EQ(result.fits[2].kind, BenchSweepKind::Voxels);
+    // Halving the voxel size gives the tiny groom more active voxels (the fit's x).
+    const auto voxelsOf = [&](std::size_t r) { return std::stod(csv[r][column("active_voxels")]); };
+    EXPECT_GT(voxelsOf(28), voxelsOf(27));
+    EXPECT_NEAR(std::stod(csv[28][column("voxel_size")]), 0.012, 1e-6);
     for (const ScalingFit& fit : result.fits) {
         ASSERT_TRUE(fit.total);
+        ASSERT_TRUE(fit.prepare);
         EXPECT_TRUE(std::isfinite(fit.total->exponent));
         EXPECT_FALSE(fit.peakMemory);
     }
@@ -214,13 +232,15 @@ TEST(BenchSweep, TinySweepWritesTablesAndPlots) {
           "4×4 blocks: noise removed | floor |",
           "| grid x1 | 0.012 | vertex |", "## Scaling with segment count",
           "## Scaling with image size", "cost ∝ pixels^k: total time k = ",
+          "## Scaling with active voxels", "| tiny 24 mm | 0.024 |",
+          "cost ∝ active voxels^k: total time k = ",
           "## Model error: dual scattering against path tracing", "| tiny, dark | grid | "})
         EXPECT_NE(text.find(needle), std::string::npos) << needle << "\n" << text;
 
     // matplotlib figures (bench/sweep/plot_sweep.py): 14 × 6.5 in at 110 dpi (per pixel and
-    // over blocks) and 2 × 7 × 5.2 in at 120 dpi.
+    // over blocks) and 3 × 7 × 5.2 in at 120 dpi (segments, pixels, active voxels).
     EXPECT_EQ(pngSize(o.outDir / "runtime_vs_error.png"), std::make_pair(1540u, 715u));
-    EXPECT_EQ(pngSize(o.outDir / "scaling.png"), std::make_pair(1680u, 624u));
+    EXPECT_EQ(pngSize(o.outDir / "scaling.png"), std::make_pair(2520u, 624u));
     EXPECT_FALSE(std::filesystem::exists(o.outDir / ".work")) << "working files are removed";
 }
 

@@ -70,6 +70,10 @@ FloatFile readFloatFile(const std::filesystem::path& path) {
 
 constexpr std::size_t kTermFloats = 11; // n, V, P, T_s, σ_f²
 
+json optionalJson(const std::optional<double>& v) {
+    return v ? json(*v) : json(nullptr);
+}
+
 json sceneToJson(const BenchScene& s) {
     return {{"label", s.label},
             {"file", s.file.string()},
@@ -78,6 +82,7 @@ json sceneToJson(const BenchScene& s) {
             {"points_per_strand", s.pointsPerStrand},
             {"width", s.width},
             {"height", s.height},
+            {"voxel_size", optionalJson(s.voxelSize)},
             {"eumelanin", s.eumelanin ? json(*s.eumelanin) : json(nullptr)}};
 }
 
@@ -91,14 +96,13 @@ BenchScene sceneFromJson(const json& j) {
     s.pointsPerStrand = j.at("points_per_strand").get<std::uint32_t>();
     s.width = j.at("width").get<std::uint32_t>();
     s.height = j.at("height").get<std::uint32_t>();
+    if (!j.at("voxel_size").is_null())
+        s.voxelSize = j.at("voxel_size").get<double>();
     if (!j.at("eumelanin").is_null())
         s.eumelanin = j.at("eumelanin").get<float>();
     return s;
 }
 
-json optionalJson(const std::optional<double>& v) {
-    return v ? json(*v) : json(nullptr);
-}
 
 std::optional<double> optionalFromJson(const json& j) {
     return j.is_null() ? std::nullopt : std::optional<double>(j.get<double>());
@@ -240,6 +244,7 @@ json measurementToJson(const BenchMeasurement& m) {
                 {"trace", t.trace},
                 {"write", t.write}}},
               {"total", m.totalSeconds},
+              {"prepare", m.prepareSeconds},
               {"runs", m.runs},
               {"peak_mib", optionalJson(m.peakMiB)},
               {"segments", m.segments},
@@ -296,6 +301,7 @@ BenchMeasurement measurementFromJson(const json& j) {
     m.times.trace = t.at("trace").get<double>();
     m.times.write = t.at("write").get<double>();
     m.totalSeconds = j.at("total").get<double>();
+    m.prepareSeconds = j.at("prepare").get<double>();
     m.runs = j.at("runs").get<int>();
     m.peakMiB = optionalFromJson(j.at("peak_mib"));
     m.segments = j.at("segments").get<std::uint64_t>();

@@ -73,7 +73,8 @@ ProbeError meanProbeError(const std::vector<std::vector<GlobalTerm>>& estimate,
 /// run is longer than singleRunAbove) and takes medians.
 BenchMeasurement timeRenders(const Scene& scene, const BenchJob& job,
                              const PipelineOptions& options, Film* lastFilm) {
-    std::vector<double> load, voxelize, tables, globalTerm, raster, shade, trace, write, total;
+    std::vector<double> load, voxelize, tables, globalTerm, prepare, raster, shade, trace, write,
+        total;
     BenchMeasurement m;
     int runs = job.runs;
     for (int r = 0; r < runs; ++r) {
@@ -83,6 +84,7 @@ BenchMeasurement timeRenders(const Scene& scene, const BenchJob& job,
         voxelize.push_back(t.voxelize);
         tables.push_back(t.tables);
         globalTerm.push_back(t.globalTerm);
+        prepare.push_back(render.globalTermPrepareSeconds);
         raster.push_back(t.raster);
         shade.push_back(t.shade);
         trace.push_back(t.trace);
@@ -109,6 +111,7 @@ BenchMeasurement timeRenders(const Scene& scene, const BenchJob& job,
     m.times.trace = median(trace);
     m.times.write = median(write);
     m.totalSeconds = median(total);
+    m.prepareSeconds = median(prepare);
     m.runs = runs;
     if (job.isolated)
         m.peakMiB = peakResidentMiB();

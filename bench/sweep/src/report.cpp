@@ -188,7 +188,8 @@ std::string csvText(const std::vector<BenchRow>& rows) {
             csvOptional(m.imageBlocks ? std::optional(m.imageBlocks->relL1) : std::nullopt),
             csvOptional(m.imageBlocks ? std::optional(m.imageBlocks->noiseFloorL1) : std::nullopt),
             csvOptional(m.imageBlocks ? std::optional(m.imageBlocks->relL1NoiseRemoved)
-                                      : std::nullopt)};
+                                      : std::nullopt),
+            csvNumber(m.prepareSeconds)};
         for (std::size_t i = 0; i < cells.size(); ++i) {
             // Scene labels are the only free text: quote them if they need it.
             const bool quote = cells[i].find_first_of(",\"\n") != std::string::npos;
@@ -385,39 +386,61 @@ std::string markdownText(const SweepOptions& o, const SweepResult& result, const
     md += modelMarkdown(o, rows);
 
     for (const ScalingFit& fit : result.fits) {
-        const bool segments = fit.kind == BenchSweepKind::Segments;
-        md += strCat("## Scaling with ", segments ? "segment count" : "image size",
-                     " (grid mode, default voxel size, fragment shading)\n\n");
-        md += strCat("| scene | segments | image ", stageHeader(), "\n");
-        md += "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
-        for (const BenchRow& r : rows)
-            if (r.kind == fit.kind)
+        const BenchSweepKind kind = fit.kind;
+        const char* x = kind == BenchSweepKind::Segments ? "segments"
+                        : kind == BenchSweepKind::Pixels ? "pixels"
+                                                         : "active voxels";
+        if (kind == BenchSweepKind::Voxels) {
+            md += "## Scaling with active voxels (one groom, grid mode, decreasing voxel sizes, "
+                  "fragment shading)\n\n";
+            md += strCat("| scene | voxel size | active voxels | lights' preparation s ",
+                         stageHeader(), "\n");
+            md += "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+        } else {
+            md += strCat("## Scaling with ",
+                         kind == BenchSweepKind::Segments ? "segment count" : "image size",
+                         " (grid mode, default voxel size, fragment shading)\n\n");
+            md += strCat("| scene | segments | image ", stageHeader(), "\n");
+            md += "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+        }
+        for (const BenchRow& r : rows) {
+            if (r.kind != kind)
+                continue;
+            if (kind == BenchSweepKind::Voxels)
+                md += strCat("| ", r.scene, " | ", format("%.3g", r.m.voxelSize), " | ",
+                             thousands(r.m.activeVoxels), " | ", seconds(r.m.prepareSeconds),
+                             " |", stageCells(r.m), "\n");
+            else
                 md += strCat("| ", r.scene, " | ", thousands(r.m.segments), " | ", imageSize(r),
                              " |", stageCells(r.m), "\n");
-        const char* x = segments ? "segments" : "pixels";
-        md += strCat(
-            "\nGrowth, least-squares fit of cost ∝ ", x, "^k: ", fitText("total time", fit.total),
-            "; ", fitText("voxelize", fit.voxelize), "; ", fitText("global term", fit.globalTerm),
-            "; ", fitText("raster + shade", fit.rasterShade), "; ",
-            fitText("peak memory", fit.peakMemory), ".\n\n");
+        }
+        md += strCat("\nGrowth, least-squares fit of cost ∝ ", x,
+                     "^k: ", fitText("total time", fit.total), "; ",
+                     fitText("voxelize", fit.voxelize), "; ", fitText("global term", fit.globalTerm),
+                     "; ", fitText("of it the lights' preparation", fit.prepare), "; ",
+                     fitText("raster + shade", fit.rasterShade), "; ",
+                     fitText("peak memory", fit.peakMemory), ".\n\n");
     }
     return md;
 }
 
 std::vector<ScalingFit> fitScaling(const std::vector<BenchRow>& rows) {
     std::vector<ScalingFit> fits;
-    for (const BenchSweepKind kind : {BenchSweepKind::Segments, BenchSweepKind::Pixels}) {
-        std::vector<double> x, total, voxelize, globalTerm, rasterShade, memX, memory;
+    for (const BenchSweepKind kind :
+         {BenchSweepKind::Segments, BenchSweepKind::Pixels, BenchSweepKind::Voxels}) {
+        std::vector<double> x, total, voxelize, globalTerm, prepare, rasterShade, memX, memory;
         for (const BenchRow& r : rows) {
             if (r.kind != kind)
                 continue;
-            const double size = kind == BenchSweepKind::Segments
-                                    ? double(r.m.segments)
-                                    : double(r.width) * double(r.height);
+            const double size = kind == BenchSweepKind::Segments ? double(r.m.segments)
+                                : kind == BenchSweepKind::Pixels
+                                    ? double(r.width) * double(r.height)
+                                    : double(r.m.activeVoxels);
             x.push_back(size);
             total.push_back(r.m.totalSeconds);
             voxelize.push_back(r.m.times.voxelize);
             globalTerm.push_back(r.m.times.globalTerm);
+            prepare.push_back(r.m.prepareSeconds);
             rasterShade.push_back(r.m.times.raster + r.m.times.shade);
             if (r.m.peakMiB) {
                 memX.push_back(size);
@@ -431,6 +454,7 @@ std::vector<ScalingFit> fitScaling(const std::vector<BenchRow>& rows) {
         fit.total = fitPowerLaw(x, total);
         fit.voxelize = fitPowerLaw(x, voxelize);
         fit.globalTerm = fitPowerLaw(x, globalTerm);
+        fit.prepare = fitPowerLaw(x, prepare);
         fit.rasterShade = fitPowerLaw(x, rasterShade);
         fit.peakMemory = fitPowerLaw(memX, memory);
         fits.push_back(fit);
@@ -445,6 +469,7 @@ std::string fitsCsvText(const std::vector<ScalingFit>& fits) {
             {"total", &fit.total},
             {"voxelize", &fit.voxelize},
             {"global term", &fit.globalTerm},
+            {"lights' preparation", &fit.prepare},
             {"raster+shade", &fit.rasterShade},
             {"peak memory", &fit.peakMemory}};
         for (const auto& [stage, f] : stages)

@@ -83,6 +83,8 @@ Scene BenchScene::build() const {
         scene.camera.width = width;
     if (height > 0)
         scene.camera.height = height;
+    if (voxelSize)
+        scene.voxelSize = static_cast<float>(*voxelSize);
     if (eumelanin)
         scene.fiber.sigma_a = FiberParams::sigmaFromMelanin(*eumelanin, 0.0f);
     scene.name = label;
@@ -168,6 +170,19 @@ std::vector<BenchScene> modelScenes(const std::filesystem::path& scenesDir, std:
     return scenes;
 }
 
+/// `scene` at each voxel size (metres), labelled with it. A missing scene
+/// file is left for validate() to name.
+std::vector<BenchScene> voxelScenes(const BenchScene& scene, std::initializer_list<double> sizes) {
+    std::vector<BenchScene> scenes;
+    for (const double h : sizes) {
+        BenchScene s = scene;
+        s.label = strCat(scene.label, " ", format("%g", h * 1e3), " mm");
+        s.voxelSize = h;
+        scenes.push_back(s);
+    }
+    return scenes;
+}
+
 } // namespace
 
 SweepOptions SweepOptions::full(const std::filesystem::path& scenesDir) {
@@ -211,6 +226,8 @@ SweepOptions SweepOptions::full(const std::filesystem::path& scenesDir) {
         s.width = s.height = size;
         o.pixelScaling.push_back(s);
     }
+    o.voxelScaling = voxelScenes(std::filesystem::exists(ratboy.file) ? ratboy.atWidth(1280) : ratboy,
+                                 {0.002, 0.001, 0.0007, 0.0005});
     o.model.scenes = modelScenes(scenesDir, 256, true);
     o.model.spp = 256;
     o.model.block = 8;
@@ -247,6 +264,11 @@ SweepOptions SweepOptions::quick(const std::filesystem::path& scenesDir) {
         s.width = s.height = size;
         o.pixelScaling.push_back(s);
     }
+    BenchScene ratboy;
+    ratboy.label = "Ratboy mohawk";
+    ratboy.file = scenesDir / "ratboy_mohawk.json";
+    o.voxelScaling = voxelScenes(std::filesystem::exists(ratboy.file) ? ratboy.atWidth(640) : ratboy,
+                                 {0.002, 0.001, 0.0005});
     o.model.scenes = modelScenes(scenesDir, 128, false);
     o.model.spp = 64;
     o.model.block = 4;
@@ -254,13 +276,17 @@ SweepOptions SweepOptions::quick(const std::filesystem::path& scenesDir) {
 }
 
 void SweepOptions::validate() const {
-    if (scenes.empty() && segmentScaling.empty() && pixelScaling.empty() && model.scenes.empty())
+    if (scenes.empty() && segmentScaling.empty() && pixelScaling.empty() && voxelScaling.empty() &&
+        model.scenes.empty())
         throw InputError("bench: nothing to measure (no scenes and no scaling sweep)");
     // The model sweep's rows are labelled "<scene>, <hair>": its scenes may
     // share labels with the accuracy sweep's, not among themselves.
     std::set<std::string> labels, modelLabels;
-    for (const auto* list : {&scenes, &segmentScaling, &pixelScaling, &model.scenes})
+    for (const auto* list : {&scenes, &segmentScaling, &pixelScaling, &voxelScaling, &model.scenes})
         for (const BenchScene& s : *list) {
+            if (s.voxelSize && !(*s.voxelSize > 0 && std::isfinite(*s.voxelSize)))
+                throw InputError(strCat("bench: ", s.label, ": voxel size ", *s.voxelSize,
+                                        " should be a positive number of metres"));
             auto& used = list == &model.scenes ? modelLabels : labels;
             if (!s.file.empty() && !std::filesystem::exists(s.file))
                 throw InputError(strCat(s.file.string(),
@@ -314,7 +340,8 @@ void runBenchJobFile(const std::filesystem::path& jobFile) {
 
 SweepResult runSweep(const SweepOptions& o) {
     o.validate();
-    for (const auto* list : {&o.scenes, &o.segmentScaling, &o.pixelScaling, &o.model.scenes})
+    for (const auto* list :
+         {&o.scenes, &o.segmentScaling, &o.pixelScaling, &o.voxelScaling, &o.model.scenes})
         for (const BenchScene& s : *list)
             s.build(); // every scene is valid before hours of work start
     std::filesystem::create_directories(o.outDir);
@@ -328,6 +355,7 @@ SweepResult runSweep(const SweepOptions& o) {
         1 + o.shadingRates.size() * (o.exactRays.size() + 2 * o.voxelScales.size());
     const std::size_t jobCount =
         o.scenes.size() * perScene + o.segmentScaling.size() + o.pixelScaling.size() +
+        o.voxelScaling.size() +
         o.model.scenes.size() * o.model.melanins.size() * (1 + o.model.modes.size());
     std::size_t jobIndex = 0;
     const auto start = Clock::now();
@@ -466,7 +494,8 @@ SweepResult runSweep(const SweepOptions& o) {
     }
 
     for (const auto& [list, kind] : {std::pair{&o.segmentScaling, BenchSweepKind::Segments},
-                                     std::pair{&o.pixelScaling, BenchSweepKind::Pixels}})
+                                     std::pair{&o.pixelScaling, BenchSweepKind::Pixels},
+                                     std::pair{&o.voxelScaling, BenchSweepKind::Voxels}})
         for (const BenchScene& scene : *list) {
             BenchJob job;
             job.scene = scene;

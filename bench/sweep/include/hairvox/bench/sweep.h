@@ -33,7 +33,9 @@
 // Scaling sweep: grid mode at the default voxel size, fragment shading, over
 // scenes of increasing segment count and increasing image size, with the
 // growth rate of each stage's time and of peak memory as the least-squares
-// exponent k of  cost ∝ size^k  (fitPowerLaw).
+// exponent k of  cost ∝ size^k  (fitPowerLaw); and a real groom at
+// decreasing voxel sizes, fitted against its active voxels (issue 16: the
+// global term's time and memory linear in them).
 //
 // Model sweep (docs/DESIGN.md §8): how far the dual-scattering *model* is from
 // the light transport it approximates. Each scene × hair colour (a eumelanin
@@ -59,7 +61,7 @@
 //   scaling_fits.csv       the fitted growth exponents
 //   runtime_vs_error.png   total time against image error, one curve (the
 //                          Pareto front) per scene, points labelled (matplotlib)
-//   scaling.png            time against segment count and against pixel count
+//   scaling.png            time against segment count, pixel count and active voxels
 #pragma once
 
 #include <hairvox/core/enum_names.h>
@@ -92,6 +94,7 @@ struct BenchScene {
     /// default when `style` swaps it.
     std::uint32_t pointsPerStrand = 0;
     std::uint32_t width = 0, height = 0; ///< resolution; 0: the scene's
+    std::optional<double> voxelSize;     ///< the grid's voxel size (metres); unset: the scene's
     /// Replaces the fiber's absorption by this eumelanin concentration (no
     /// pheomelanin; FiberParams::sigmaFromMelanin).
     std::optional<float> eumelanin;
@@ -135,6 +138,9 @@ inline constexpr int kAccuracyBlock = 4;
 struct BenchMeasurement {
     StageTimes times;        ///< per-stage medians over the runs
     double totalSeconds = 0; ///< median of the end-to-end totals
+    /// Of times.globalTerm, the lights' preparation (median; the rest is the
+    /// lookups made while shading).
+    double prepareSeconds = 0;
     int runs = 0;
     std::optional<double> peakMiB; ///< peak resident memory of the job's own process
     std::uint64_t segments = 0, shadingPoints = 0, activeVoxels = 0;
@@ -153,15 +159,17 @@ enum class BenchSweepKind {
     Accuracy,      ///< a configuration of the accuracy sweep
     Segments,      ///< scaling with segment count
     Pixels,        ///< scaling with image size
+    Voxels,        ///< scaling with active voxels (one groom, decreasing voxel sizes)
     PathReference, ///< the model sweep's path-traced reference of a scene and hair colour
     Model,         ///< dual scattering in one mode against that reference
 };
 
-inline constexpr EnumNames<BenchSweepKind, 6> kBenchSweepKindNames{{{
+inline constexpr EnumNames<BenchSweepKind, 7> kBenchSweepKindNames{{{
     {BenchSweepKind::Reference, "reference"},
     {BenchSweepKind::Accuracy, "accuracy"},
     {BenchSweepKind::Segments, "segments"},
     {BenchSweepKind::Pixels, "pixels"},
+    {BenchSweepKind::Voxels, "voxels"},
     {BenchSweepKind::PathReference, "path_reference"},
     {BenchSweepKind::Model, "model"},
 }}};
@@ -181,10 +189,10 @@ struct BenchRow {
 /// Least-squares growth exponents of a scaling sweep (nullopt where not fitted).
 struct ScalingFit {
     BenchSweepKind kind = BenchSweepKind::Segments;
-    std::optional<PowerLawFit> total, voxelize, globalTerm, rasterShade, peakMemory;
+    std::optional<PowerLawFit> total, voxelize, globalTerm, prepare, rasterShade, peakMemory;
 };
 
-inline constexpr std::array<const char*, 36> kBenchCsvColumns = {
+inline constexpr std::array<const char*, 37> kBenchCsvColumns = {
     "sweep",         "scene",          "mode",
     "voxel_scale",   "voxel_size",     "rays",
     "shading_rate",  "width",          "height",
@@ -196,7 +204,8 @@ inline constexpr std::array<const char*, 36> kBenchCsvColumns = {
     "mae_v",         "mae_ts",         "eumelanin",
     "rel_bias",      "noise_floor_l1", "rel_l1_noise_removed",
     "spp",           "rays_per_s",     "paths_per_s",
-    "block_rel_l1",  "block_noise_floor_l1", "block_rel_l1_noise_removed"};
+    "block_rel_l1",  "block_noise_floor_l1", "block_rel_l1_noise_removed",
+    "global_term_prepare_s"};
 
 /// The model sweep (see the file comment).
 struct ModelSweepOptions {
@@ -223,6 +232,7 @@ struct SweepOptions {
     std::uint64_t probeSeed = 1;
     std::vector<BenchScene> segmentScaling; ///< scenes of increasing segment count
     std::vector<BenchScene> pixelScaling;   ///< scenes of increasing image size
+    std::vector<BenchScene> voxelScaling;   ///< one groom at decreasing voxel sizes
     ModelSweepOptions model;                ///< no scenes: no model sweep
     int runs = 3;                           ///< timed renders per configuration, [1, 100]
     /// A configuration whose first run takes longer (seconds) is run once: the
@@ -240,15 +250,15 @@ struct SweepOptions {
     /// (1024²), Ratboy_mohawk (`ratboyScene`, 960²), the TressFX bear's fur
     /// (`bear.json`, 144k segments, 1280²) and the 50,000-strand ×
     /// 29-point wavy head (1.4M segments, 1920×1080); five voxel sizes; exact
-    /// with 1 and 4 rays against 16; scaling 10k–1.4M segments at 1920×1080
-    /// and 256²–2048²; the model sweep on the default scene, the curly
+    /// with 1 and 4 rays against 16; scaling 10k–1.4M segments at 1920×1080,
+    /// 256²–2048², and Ratboy at 1280² from 2 mm to 0.5 mm voxels; the model sweep on the default scene, the curly
     /// close-up and Ratboy at 256² (the scenes' aspect), blond, medium and
     /// dark, 256 spp, 8 × 8 blocks.
     static SweepOptions full(const std::filesystem::path& scenesDir);
-    /// A representative subset in under 15 minutes on 2 cores: wavy and curly
+    /// A representative subset in 3–7 minutes on 2 cores: wavy and curly
     /// at 512², voxel sizes ×4, ×2, ×1, exact with 1 ray against 4, fragment
     /// shading, one run per configuration; scaling 10k–400k segments at
-    /// 960×540 and 256²–1024²; the model sweep on the default scene and the
+    /// 960×540, 256²–1024², and Ratboy at 640² at 2, 1 and 0.5 mm voxels; the model sweep on the default scene and the
     /// curly close-up at 128², 64 spp, 4 × 4 blocks.
     static SweepOptions quick(const std::filesystem::path& scenesDir);
 
