@@ -2,8 +2,8 @@
 //               [--no-accuracy] [--no-model]
 // Sweeps global-term mode × voxel size × shading rate against exact-mode
 // references, dual scattering against the path tracer (the model sweep), then
-// time and memory against segment count and image size (bench/sweep); writes
-// results.csv, results.md and PNG plots.
+// time and memory against segment count, image size and active voxels
+// (bench/sweep); writes results.csv, results.md and PNG plots.
 // `hairvox bench --one JOB.json` is the worker that runs one job of a sweep in
 // its own process (so that its peak memory is its own).
 #include "../commands.h"
@@ -105,7 +105,7 @@ void addBenchCommand(CLI::App& app) {
     auto opt = std::make_shared<BenchOptions>();
     CLI::App* cmd = app.add_subcommand(
         "bench", "Benchmark: run time against error per mode, voxel size and shading rate, and "
-                 "how cost grows with segment count and image size");
+                 "how cost grows with segment count, image size and voxel size");
     cmd->add_option("--scene", opt->scenes,
                     "Scene JSON file(s) to sweep instead of the default set (repeatable)");
     cmd->add_option("-o,--out", opt->out, "Output directory (results.csv, results.md, PNG plots)");

@@ -172,6 +172,47 @@ TEST(GridGlobalTerm, CacheStoresNothingAcrossEmptySpaceAndAgreesWithTheMarch) {
         << held[1] << " bytes";
 }
 
+TEST(GridGlobalTerm, CacheAgreesWithTheMarchUnderAPointLightAndAnAxisAlignedOne) {
+    // The cache's lines are given the bricks whose values can reach them
+    // (LightSpaceCache::build bins each brick's value box by the lattice's
+    // lines): a brick left out is a shadow missed. A point light's lines
+    // radiate from it (a perspective lattice); a light along an axis puts
+    // lines on brick faces. Both must find what the march finds.
+    const test::Slab slab;
+    const FiberGrid grid = splat(slab.groom(), 0.002);
+    GridOptions march;
+    march.evaluation = GridEvaluation::March;
+    const CrossingTable table = constantTable(0.5f, 0.01f);
+    const auto cacheModel = makeGridModel(grid, {table}, slabSettings(), {});
+    const auto marchModel = makeGridModel(grid, {table}, slabSettings(), march);
+    for (const Light& light : {Light::point(Vec3f(0.004f, 0.4f, -0.01f)),
+                               Light::directional(Vec3f(0, 1, 0))}) {
+        const auto cached = cacheModel->forLight(light);
+        const auto marched = marchModel->forLight(light);
+        std::vector<GlobalTermQuery> queries;
+        Pcg32 rng(5);
+        for (const float y : {-0.004f, 0.003f, 0.007f})
+            for (int i = 0; i < 50; ++i)
+                queries.push_back(
+                    {Vec3f(rng.uniform(-0.01f, 0.01f), y, rng.uniform(-0.03f, 0.03f)),
+                     Vec3f(1, 0, 0)});
+        std::vector<GlobalTerm> a(queries.size()), b(queries.size());
+        cached->evaluate(queries, a);
+        marched->evaluate(queries, b);
+        for (std::size_t row = 0; row < 3; ++row) {
+            double meanA = 0, meanB = 0;
+            for (std::size_t i = 50 * row; i < 50 * (row + 1); ++i) {
+                EXPECT_NEAR(a[i].n, b[i].n, 0.2f * b[i].n + 0.03f)
+                    << light << " at " << queries[i].position;
+                meanA += double(a[i].n) / 50;
+                meanB += double(b[i].n) / 50;
+            }
+            EXPECT_NEAR(meanA, meanB, 0.02 * meanB + 0.01) << light << " row " << row;
+        }
+        EXPECT_GT(b.front().n, 1.5f) << light << ": below the slab, the slab is crossed";
+    }
+}
+
 TEST(GridGlobalTerm, AQueryDoesNotDependOnItsBatch) {
     // The cache's lookups go in batches that prefetch together
     // (LightSpaceCache::lookup): a query's value must be the one it gets

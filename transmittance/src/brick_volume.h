@@ -24,7 +24,7 @@
 // skipping empty space a super-brick (4³ bricks) at a time; the light cache's
 // lattice lines (integrateCumulative) are given the bricks whose values can
 // reach them, binned by brick rather than found by walking (at 0.5 mm on
-// Ratboy a lattice line passed 4 bricks for each whose values it met).
+// Ratboy a lattice line passed 3.4 bricks for each whose values it met).
 #pragma once
 
 #include <hairvox/core/grid_traversal.h>
@@ -265,10 +265,10 @@ private:
     /// One bit per brick position of [brickMin_, brickMax_] (x fastest), set
     /// where a brick exists; built by allocateSlots().
     std::vector<std::uint64_t> occupancy_;
-    /// The same one level up, per super-brick of kSuper³ bricks: a line's walk
-    /// crosses empty space a super-brick at a time. At fine voxels the bricks
-    /// are sparse (Ratboy at 0.5 mm: 95% of the brick positions lines cross
-    /// are empty) and walking them one by one grew faster than the hair.
+    /// The same one level up, per super-brick of kSuper³ bricks: a march's
+    /// walk crosses empty space a super-brick at a time. At fine voxels the
+    /// bricks are sparse (Ratboy at 0.5 mm: 95% of the brick positions a line
+    /// crosses are empty), and walking them one by one grew faster than the hair.
     static constexpr int kSuperShift = 2;
     static constexpr int kSuper = 1 << kSuperShift;
     glm::ivec3 superMin_{0}, superMax_{-1};

@@ -103,9 +103,13 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates, 
     struct LineRect {
         int i0 = 0, i1 = -1, j0 = 0, j1 = -1; ///< lines [i0, i1] × [j0, j1]; empty if i0 > i1
     };
+    if (rates.brickCount() > std::numeric_limits<std::uint32_t>::max())
+        throw std::length_error("light-space cache: more than 2^32 bricks");
     std::vector<LineRect> reach(rates.brickCount());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, reach.size()), [&](const auto& range) {
-        constexpr float kMargin = 0.25f; // of a line
+        // A quarter of a line, more where the lattice's coordinates are so
+        // large that their rounding is (toLattice subtracts i0, j0).
+        const float offset = static_cast<float>(std::max(std::abs(cache.i0_), std::abs(cache.j0_)));
         for (std::size_t brick = range.begin(); brick != range.end(); ++brick) {
             const Bounds3f box = rates.valueBounds(brick);
             if (box.empty())
@@ -118,11 +122,14 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates, 
                 v0 = std::min(v0, l.y);
                 v1 = std::max(v1, l.y);
             }
+            const float margin =
+                0.25f + 64.0f * std::numeric_limits<float>::epsilon() *
+                            (offset + std::max({std::abs(u0), std::abs(u1), std::abs(v0), std::abs(v1)}));
             LineRect& r = reach[brick];
-            r.i0 = std::max(static_cast<int>(std::ceil(u0 - kMargin)), 0);
-            r.i1 = std::min(static_cast<int>(std::floor(u1 + kMargin)), cache.ni_ - 1);
-            r.j0 = std::max(static_cast<int>(std::ceil(v0 - kMargin)), 0);
-            r.j1 = std::min(static_cast<int>(std::floor(v1 + kMargin)), cache.nj_ - 1);
+            r.i0 = std::max(static_cast<int>(std::ceil(u0 - margin)), 0);
+            r.i1 = std::min(static_cast<int>(std::floor(u1 + margin)), cache.ni_ - 1);
+            r.j0 = std::max(static_cast<int>(std::ceil(v0 - margin)), 0);
+            r.j1 = std::min(static_cast<int>(std::floor(v1 + margin)), cache.nj_ - 1);
             if (r.j0 > r.j1)
                 r.i1 = r.i0 - 1;
         }
@@ -156,7 +163,8 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates, 
     cache.tiles_.resize(tileCount);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tileCount), [&](const auto& range) {
         struct Scratch {
-            std::vector<std::uint32_t> lineStart, lineBricks; ///< per line of the tile, its bricks
+            std::vector<std::size_t> lineStart;   ///< per line of the tile, where its bricks start
+            std::vector<std::uint32_t> lineBricks; ///< the bricks of the tile's lines, line by line
             std::vector<BrickVolume::BrickCrossing> crossings;
             std::vector<BrickVolume::CumulativeSample> recorded;
             std::vector<Run> runs;
@@ -165,7 +173,7 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates, 
         ThreadScratch<Scratch> scratch;
         // (References, not a structured binding: Clang 14 does not let the
         // lambda below capture one.)
-        std::vector<std::uint32_t>& lineStart = scratch->lineStart;
+        std::vector<std::size_t>& lineStart = scratch->lineStart;
         std::vector<std::uint32_t>& lineBricks = scratch->lineBricks;
         std::vector<BrickVolume::CumulativeSample>& recorded = scratch->recorded;
         std::vector<Run>& runs = scratch->runs;
@@ -197,7 +205,7 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates, 
             // (Each lineStart[l] now holds line l's end, the start of line l + 1.)
             for (std::size_t l = 0; l < kLinesPerTile; ++l) {
                 lineRuns[l] = static_cast<std::uint32_t>(runs.size());
-                const std::uint32_t begin = l == 0 ? 0 : lineStart[l - 1], end = lineStart[l];
+                const std::size_t begin = l == 0 ? 0 : lineStart[l - 1], end = lineStart[l];
                 if (begin == end)
                     continue; // no value reaches the line (or padding): it stores nothing
                 const int li = tileI + static_cast<int>(l % kTile);
