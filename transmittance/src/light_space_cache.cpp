@@ -123,8 +123,9 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates, 
                 v1 = std::max(v1, l.y);
             }
             const float margin =
-                0.25f + 64.0f * std::numeric_limits<float>::epsilon() *
-                            (offset + std::max({std::abs(u0), std::abs(u1), std::abs(v0), std::abs(v1)}));
+                0.25f +
+                64.0f * std::numeric_limits<float>::epsilon() *
+                    (offset + std::max({std::abs(u0), std::abs(u1), std::abs(v0), std::abs(v1)}));
             LineRect& r = reach[brick];
             r.i0 = std::max(static_cast<int>(std::ceil(u0 - margin)), 0);
             r.i1 = std::min(static_cast<int>(std::floor(u1 + margin)), cache.ni_ - 1);
@@ -163,7 +164,7 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates, 
     cache.tiles_.resize(tileCount);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tileCount), [&](const auto& range) {
         struct Scratch {
-            std::vector<std::size_t> lineStart;   ///< per line of the tile, where its bricks start
+            std::vector<std::size_t> lineStart;    ///< per line of the tile, where its bricks start
             std::vector<std::uint32_t> lineBricks; ///< the bricks of the tile's lines, line by line
             std::vector<BrickVolume::BrickCrossing> crossings;
             std::vector<BrickVolume::CumulativeSample> recorded;
@@ -219,12 +220,14 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates, 
                 // (consecutive k); every other sample equals the one kept before it.
                 const auto changes = [&](std::size_t i) {
                     return recorded[i + 1].k == recorded[i].k + 1 &&
-                           !std::equal(std::begin(recorded[i].value.v), std::end(recorded[i].value.v),
+                           !std::equal(std::begin(recorded[i].value.v),
+                                       std::end(recorded[i].value.v),
                                        std::begin(recorded[i + 1].value.v));
                 };
                 bool keptPrevious = false;
                 for (std::size_t i = 0; i < recorded.size(); ++i) {
-                    const bool keep = (i > 0 && changes(i - 1)) || (i + 1 < recorded.size() && changes(i));
+                    const bool keep =
+                        (i > 0 && changes(i - 1)) || (i + 1 < recorded.size() && changes(i));
                     if (!keep) {
                         keptPrevious = false;
                         continue;
