@@ -28,6 +28,37 @@ FiberGrid splat(const Groom& groom, double voxelSize) {
     return splatStrands(groom, options);
 }
 
+/// Compares a light's cached global term with its march at 50 random points
+/// at each of `heights` in a slab's plane (x in ±1 cm, z in ±3 cm): n within
+/// relative·n + absolute per point, each row's mean within 2%. Returns the
+/// march's values.
+std::vector<GlobalTerm> expectCacheMatchesMarch(const LightGlobalTerm& cached,
+                                                const LightGlobalTerm& marched,
+                                                std::span<const float> heights, std::uint64_t seed,
+                                                float relative, float absolute,
+                                                const std::string& what) {
+    std::vector<GlobalTermQuery> queries;
+    Pcg32 rng(seed);
+    for (const float y : heights)
+        for (int i = 0; i < 50; ++i)
+            queries.push_back({Vec3f(rng.uniform(-0.01f, 0.01f), y, rng.uniform(-0.03f, 0.03f)),
+                               Vec3f(1, 0, 0)});
+    std::vector<GlobalTerm> a(queries.size()), b(queries.size());
+    cached.evaluate(queries, a);
+    marched.evaluate(queries, b);
+    for (std::size_t row = 0; row < heights.size(); ++row) {
+        double meanA = 0, meanB = 0;
+        for (std::size_t i = 50 * row; i < 50 * (row + 1); ++i) {
+            EXPECT_NEAR(a[i].n, b[i].n, relative * b[i].n + absolute)
+                << what << " at " << queries[i].position;
+            meanA += double(a[i].n) / 50;
+            meanB += double(b[i].n) / 50;
+        }
+        EXPECT_NEAR(meanA, meanB, 0.02 * meanB + 0.01) << what << " row " << row;
+    }
+    return b;
+}
+
 TEST(GridGlobalTerm, SlabMatchesClosedForms) {
     const test::Slab slab;
     const FiberGrid grid = splat(slab.groom(), 0.002);
@@ -140,30 +171,13 @@ TEST(GridGlobalTerm, CacheStoresNothingAcrossEmptySpaceAndAgreesWithTheMarch) {
         const auto cached = cacheModel->forLight(Light::directional(omega));
         const auto marched = marchModel->forLight(Light::directional(omega));
         held[g] = cached->memoryBytes();
-        std::vector<GlobalTermQuery> queries;
-        Pcg32 rng(3);
-        for (const float y : {-0.004f, 0.005f, 0.01f + 0.5f * gap, gap + 0.005f})
-            for (int i = 0; i < 50; ++i)
-                queries.push_back(
-                    {Vec3f(rng.uniform(-0.01f, 0.01f), y, rng.uniform(-0.03f, 0.03f)),
-                     Vec3f(1, 0, 0)});
-        std::vector<GlobalTerm> a(queries.size()), b(queries.size());
-        cached->evaluate(queries, a);
-        marched->evaluate(queries, b);
         // Per point, the lattice's interpolation of a noisy density (~16
         // fibers per voxel column) differs from the march by up to ~15% (a
         // slab missed would be 50%); over 50 points at one height it averages
         // out. The paths stay inside the slabs' sides.
-        for (std::size_t row = 0; row < 4; ++row) {
-            double meanA = 0, meanB = 0;
-            for (std::size_t i = 50 * row; i < 50 * (row + 1); ++i) {
-                EXPECT_NEAR(a[i].n, b[i].n, 0.2f * b[i].n + 0.03f)
-                    << "gap " << gap << " at " << queries[i].position;
-                meanA += double(a[i].n) / 50;
-                meanB += double(b[i].n) / 50;
-            }
-            EXPECT_NEAR(meanA, meanB, 0.02 * meanB + 0.01) << "gap " << gap << " row " << row;
-        }
+        const float heights[] = {-0.004f, 0.005f, 0.01f + 0.5f * gap, gap + 0.005f};
+        const std::vector<GlobalTerm> b = expectCacheMatchesMarch(
+            *cached, *marched, heights, 3, 0.2f, 0.03f, strCat("gap ", gap));
         EXPECT_GT(b.front().n, 3.0f) << "below both slabs: both are crossed";
     }
     EXPECT_GT(held[0], 0u);
@@ -187,31 +201,13 @@ TEST(GridGlobalTerm, CacheAgreesWithTheMarchUnderAPointLightAndAnAxisAlignedOne)
     const auto marchModel = makeGridModel(grid, {table}, slabSettings(), march);
     for (const Light& light : {Light::point(Vec3f(0.004f, 0.4f, -0.01f)),
                                Light::directional(Vec3f(0, 1, 0))}) {
-        const auto cached = cacheModel->forLight(light);
-        const auto marched = marchModel->forLight(light);
-        std::vector<GlobalTermQuery> queries;
-        Pcg32 rng(5);
-        for (const float y : {-0.004f, 0.003f, 0.007f})
-            for (int i = 0; i < 50; ++i)
-                queries.push_back(
-                    {Vec3f(rng.uniform(-0.01f, 0.01f), y, rng.uniform(-0.03f, 0.03f)),
-                     Vec3f(1, 0, 0)});
-        std::vector<GlobalTerm> a(queries.size()), b(queries.size());
-        cached->evaluate(queries, a);
-        marched->evaluate(queries, b);
         // Per point the lattice's interpolation differs from the march by up
         // to a third near the slab's top face, where n is small (a brick left
         // out loses its whole 8-voxel span of the slab); over a row it averages out.
-        for (std::size_t row = 0; row < 3; ++row) {
-            double meanA = 0, meanB = 0;
-            for (std::size_t i = 50 * row; i < 50 * (row + 1); ++i) {
-                EXPECT_NEAR(a[i].n, b[i].n, 0.35f * b[i].n + 0.05f)
-                    << light << " at " << queries[i].position;
-                meanA += double(a[i].n) / 50;
-                meanB += double(b[i].n) / 50;
-            }
-            EXPECT_NEAR(meanA, meanB, 0.02 * meanB + 0.01) << light << " row " << row;
-        }
+        const float heights[] = {-0.004f, 0.003f, 0.007f};
+        const std::vector<GlobalTerm> b =
+            expectCacheMatchesMarch(*cacheModel->forLight(light), *marchModel->forLight(light),
+                                    heights, 5, 0.35f, 0.05f, strCat(light));
         EXPECT_GT(b.front().n, 1.5f) << light << ": below the slab, the slab is crossed";
     }
 }
