@@ -75,8 +75,8 @@ struct alignas(32) Lanes {
 };
 
 /// The corners of a cell that hold a value: at fine voxels a strand crosses a
-/// brick alone, and a cell a lattice line walks has ~2 of its 8 (the others
-/// read zero and add nothing to an interpolation).
+/// brick alone, and a cell a line walks has few of its 8 (the others read
+/// zero and add nothing to an interpolation).
 struct CellCorners {
     int count = 0;
     std::array<std::uint8_t, 8> k;          ///< corner dx·4 + dy·2 + dz

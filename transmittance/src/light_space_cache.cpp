@@ -176,6 +176,7 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates, 
         // lambda below capture one.)
         std::vector<std::size_t>& lineStart = scratch->lineStart;
         std::vector<std::uint32_t>& lineBricks = scratch->lineBricks;
+        std::vector<BrickVolume::BrickCrossing>& crossings = scratch->crossings;
         std::vector<BrickVolume::CumulativeSample>& recorded = scratch->recorded;
         std::vector<Run>& runs = scratch->runs;
         std::vector<Lanes>& samples = scratch->samples;
@@ -215,7 +216,7 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates, 
                 const Vec3f origin = cache.lineOrigin(li, lj, dir);
                 rates.integrateCumulative(origin, dir, 0.0f, cache.h_, samplesPerLine, opaqueDepth,
                                           std::span(lineBricks.data() + begin, end - begin),
-                                          scratch->crossings, recorded);
+                                          crossings, recorded);
                 // Keep the samples at either end of a step where the value changes
                 // (consecutive k); every other sample equals the one kept before it.
                 const auto changes = [&](std::size_t i) {

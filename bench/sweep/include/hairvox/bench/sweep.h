@@ -251,15 +251,16 @@ struct SweepOptions {
     /// (`bear.json`, 144k segments, 1280²) and the 50,000-strand ×
     /// 29-point wavy head (1.4M segments, 1920×1080); five voxel sizes; exact
     /// with 1 and 4 rays against 16; scaling 10k–1.4M segments at 1920×1080,
-    /// 256²–2048², and Ratboy at 1280² from 2 mm to 0.5 mm voxels; the model sweep on the default scene, the curly
-    /// close-up and Ratboy at 256² (the scenes' aspect), blond, medium and
-    /// dark, 256 spp, 8 × 8 blocks.
+    /// 256²–2048², and Ratboy at 1280² from 2 mm to 0.5 mm voxels; the model
+    /// sweep on the default scene, the curly close-up and Ratboy at 256² (the
+    /// scenes' aspect), blond, medium and dark, 256 spp, 8 × 8 blocks.
     static SweepOptions full(const std::filesystem::path& scenesDir);
     /// A representative subset in 3–7 minutes on 2 cores: wavy and curly
     /// at 512², voxel sizes ×4, ×2, ×1, exact with 1 ray against 4, fragment
     /// shading, one run per configuration; scaling 10k–400k segments at
-    /// 960×540, 256²–1024², and Ratboy at 640² at 2, 1 and 0.5 mm voxels; the model sweep on the default scene and the
-    /// curly close-up at 128², 64 spp, 4 × 4 blocks.
+    /// 960×540, 256²–1024², and Ratboy at 640² at 2, 1 and 0.5 mm voxels;
+    /// the model sweep on the default scene and the curly close-up at 128²,
+    /// 64 spp, 4 × 4 blocks.
     static SweepOptions quick(const std::filesystem::path& scenesDir);
 
     void validate() const;
