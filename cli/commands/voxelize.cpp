@@ -21,6 +21,13 @@ namespace hairvox::cli {
 
 namespace {
 
+/// Bytes in GiB, to 3 significant digits.
+std::string gib(std::uint64_t bytes) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.3g", double(bytes) / double(1ull << 30));
+    return text;
+}
+
 struct VoxelizeOptions {
     std::string input;
     std::string output;
@@ -65,6 +72,14 @@ void runVoxelize(const VoxelizeOptions& opt) {
     for (const std::string& w : grid.warnings)
         std::fprintf(stderr, "hairvox: warning: %s: %s\n", opt.input.c_str(), w.c_str());
 
+    // The file is OpenVDB's grids, whose dense leaves the packed grid does
+    // not have: refuse before building them what the budget cannot hold.
+    const std::uint64_t vdbBytes = vdbMemoryBytes(grid);
+    if (grid.memoryBytes() + vdbBytes > splat.memoryBudgetBytes)
+        throw InputError(strCat(opt.output, ": writing the fiber grid needs its OpenVDB leaves, ",
+                                gib(vdbBytes), " GiB beside the grid's ", gib(grid.memoryBytes()),
+                                " GiB, over the memory budget of ", opt.memoryBudgetGiB,
+                                " GiB; use a larger voxel size or --memory-budget"));
     start = std::chrono::steady_clock::now();
     writeFiberGrid(opt.output, grid);
     const double writeSeconds = secondsSince(start);
@@ -75,9 +90,11 @@ void runVoxelize(const VoxelizeOptions& opt) {
     std::printf("voxel size:     %.6g (%.0f voxels across the groom)\n", grid.info.voxelSize,
                 longest > 0 ? std::ceil(longest / grid.info.voxelSize) : 0.0);
     std::printf("active voxels:  %s\n", thousands(grid.activeVoxelCount()).c_str());
-    std::printf("memory:         %.1f MiB (%s)\n", double(grid.memoryBytes()) / double(1 << 20),
+    std::printf("memory:         %.1f MiB (%s), %.1f MiB as the file's OpenVDB grids\n",
+                double(grid.memoryBytes()) / double(1 << 20),
                 grid.hasTensor() ? "density, orientation, orientation tensor"
-                                 : "density, orientation");
+                                 : "density, orientation",
+                double(vdbBytes) / double(1 << 20));
     std::printf("fiber length:   %.6g in %s strands, %s segments\n", grid.info.totalLength,
                 thousands(grid.info.strands).c_str(), thousands(grid.info.segments).c_str());
     std::printf("time:           read %.3f s, voxelize %.3f s (%d threads), write %.3f s\n",

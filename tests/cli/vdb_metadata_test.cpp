@@ -105,5 +105,19 @@ TEST(VdbMetadata, FiberGridIsSelfDescribing) {
     }
 }
 
+TEST(VdbMetadata, VoxelizeRefusesAFileItsBudgetCannotBuild) {
+    // At 1 mm Ratboy's packed grid (~20 MB) fits 0.1 GiB, the OpenVDB leaves
+    // its file needs (~180 MB, dense 8³ each) do not: refused before they
+    // are built, and no file is left.
+    test::TempDir dir;
+    const fs::path vdb = dir / "fibers.vdb";
+    const auto r = test::runHairvox("voxelize " + quoted(test::dataDir() / "Ratboy_mohawk.tfx") +
+                                    " --voxel-size 0.001 --memory-budget 0.1 -o " + quoted(vdb));
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("OpenVDB leaves"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("budget"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(vdb));
+}
+
 } // namespace
 } // namespace hairvox

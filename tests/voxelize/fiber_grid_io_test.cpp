@@ -77,12 +77,21 @@ TEST(FiberGridIo, RoundTripKeepsValuesAndMetadata) {
         EXPECT_TRUE(test::sameFiberGrid(grid, back));
         EXPECT_EQ(back.hasTensor(), tensor);
         expectSameInfo(grid.info, back.info);
-        EXPECT_EQ(back.density->getName(), "density");
-        EXPECT_EQ(back.density->getGridClass(), openvdb::GRID_FOG_VOLUME);
-        EXPECT_EQ(back.density->transform(), grid.density->transform());
-        // The metadata went to the file, not onto the caller's grids.
-        EXPECT_TRUE(back.density->getMetadata<openvdb::DoubleMetadata>("voxel_size"));
-        EXPECT_FALSE(grid.density->getMetadata<openvdb::DoubleMetadata>("voxel_size"));
+        // The file holds OpenVDB grids of the packed voxels, one leaf per block.
+        openvdb::io::File file(path.string());
+        file.open();
+        const auto density = openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid("density"));
+        ASSERT_TRUE(density);
+        EXPECT_EQ(density->getGridClass(), openvdb::GRID_FOG_VOLUME);
+        EXPECT_EQ(density->transform(),
+                  *openvdb::math::Transform::createLinearTransform(grid.info.voxelSize));
+        EXPECT_TRUE(density->getMetadata<openvdb::DoubleMetadata>("voxel_size"));
+        EXPECT_EQ(density->tree().leafCount(), grid.blocks.size());
+        EXPECT_EQ(density->activeVoxelCount(), grid.activeVoxelCount());
+        grid.forEachVoxel([&](std::size_t i, const openvdb::Coord& c) {
+            EXPECT_EQ(density->tree().getValue(c), grid.density[i]) << c;
+        });
+        EXPECT_EQ(file.hasGrid("tensorDiag"), tensor);
     }
     EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), {}), 2)
         << "temporary files were left behind";
@@ -112,8 +121,10 @@ TEST(FiberGridIo, BadFilesAreInputErrorsNamingTheFile) {
     EXPECT_NE(readFiberGridError(dir / "foo.vdb").find("'density'"), std::string::npos);
 
     // The right grids without hairvox metadata.
-    const FiberGrid grid = smallGrid(false);
-    writeRawVdb(dir / "nometa.vdb", {grid.density, grid.orientation});
+    const FiberVdbGrids grid = toVdbGrids(smallGrid(false));
+    for (const auto& g : grid.all())
+        g->removeMeta("voxel_size");
+    writeRawVdb(dir / "nometa.vdb", grid.all());
     const std::string noMeta = readFiberGridError(dir / "nometa.vdb");
     EXPECT_NE(noMeta.find("nometa.vdb"), std::string::npos) << noMeta;
     EXPECT_NE(noMeta.find("metadata"), std::string::npos) << noMeta;
@@ -127,25 +138,53 @@ TEST(FiberGridIo, BadFilesAreInputErrorsNamingTheFile) {
 
 TEST(FiberGridIo, RefusesOtherTransformsAndBadValues) {
     test::TempDir dir;
-    FiberGrid grid = smallGrid(false);
+    const FiberGrid grid = smallGrid(false);
 
     // A cell-centred (offset) transform would silently shift every sample.
-    FiberGrid shifted = grid;
-    shifted.density = grid.density->deepCopy();
+    FiberVdbGrids shifted = toVdbGrids(grid);
     shifted.density->transform().postTranslate(openvdb::Vec3d(0.5 * grid.info.voxelSize));
-    writeFiberGrid(dir / "shifted.vdb", shifted);
+    writeVdbFile(dir / "shifted.vdb", shifted.all());
     EXPECT_NE(readFiberGridError(dir / "shifted.vdb").find("transform"), std::string::npos);
 
-    FiberGrid negative = grid;
-    negative.density = grid.density->deepCopy();
+    FiberVdbGrids negative = toVdbGrids(grid);
     negative.density->tree().setValueOn(openvdb::Coord(0, 0, 0), -1.0f);
-    writeFiberGrid(dir / "negative.vdb", negative);
+    writeVdbFile(dir / "negative.vdb", negative.all());
     EXPECT_NE(readFiberGridError(dir / "negative.vdb").find(">= 0"), std::string::npos);
 
-    FiberGrid oneTensor = smallGrid(true);
+    FiberVdbGrids oneTensor = toVdbGrids(smallGrid(true));
     oneTensor.tensorOffDiag = nullptr;
-    writeFiberGrid(dir / "onetensor.vdb", oneTensor);
+    writeVdbFile(dir / "onetensor.vdb", oneTensor.all());
     EXPECT_NE(readFiberGridError(dir / "onetensor.vdb").find("tensor"), std::string::npos);
+
+    // An active tile of 128³ voxels: a grid of the user's, not a splat; its
+    // voxels would otherwise be dropped unseen.
+    FiberVdbGrids tiled = toVdbGrids(grid);
+    tiled.density->tree().addTile(2, openvdb::Coord(1 << 12), 1.0f, true);
+    writeVdbFile(dir / "tiled.vdb", tiled.all());
+    const std::string tiles = readFiberGridError(dir / "tiled.vdb");
+    EXPECT_NE(tiles.find("active tiles"), std::string::npos) << tiles;
+}
+
+TEST(FiberGridIo, ReadsOtherGridsAtTheDensitysVoxels) {
+    // A foreign file whose orientation grid lacks a voxel the density has:
+    // that voxel reads the orientation's background, and a value where the
+    // density has none is not a voxel.
+    test::TempDir dir;
+    const FiberGrid grid = smallGrid(false);
+    ASSERT_GT(grid.activeVoxelCount(), 2u);
+    FiberVdbGrids vdb = toVdbGrids(grid);
+    const openvdb::Coord first =
+        grid.blocks.front().voxel(grid.blocks.front().active.findFirstOn());
+    vdb.orientation->tree().setValueOff(first, openvdb::Vec3s(0.0f));
+    vdb.orientation->tree().setValueOn(openvdb::Coord(-(1 << 12)), openvdb::Vec3s(1, 0, 0));
+    writeVdbFile(dir / "foreign.vdb", vdb.all());
+    const FiberGrid back = readFiberGrid(dir / "foreign.vdb");
+    EXPECT_TRUE(test::sameBits(back.density, grid.density));
+    ASSERT_EQ(back.orientation.size(), grid.orientation.size());
+    EXPECT_EQ(back.orientation[0], openvdb::Vec3s(0.0f));
+    EXPECT_EQ(back.find(openvdb::Coord(-(1 << 12))), FiberGrid::kInactive);
+    for (std::size_t i = 1; i < back.orientation.size(); ++i)
+        EXPECT_EQ(back.orientation[i], grid.orientation[i]) << i;
 }
 
 TEST(FiberGridIo, UnwritablePathIsAnInputError) {

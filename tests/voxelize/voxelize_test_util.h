@@ -13,8 +13,8 @@ namespace hairvox::test {
 /// Σ_v λ_v h³: the fiber length the density grid holds.
 inline double splattedLength(const FiberGrid& grid) {
     double sum = 0;
-    for (auto it = grid.density->cbeginValueOn(); it; ++it)
-        sum += double(*it);
+    for (const float lambda : grid.density)
+        sum += double(lambda);
     const double h = grid.info.voxelSize;
     return sum * h * h * h;
 }
@@ -30,32 +30,26 @@ inline double exactLength(const Groom& groom) {
     return sum;
 }
 
-/// Same topology and bitwise-identical voxel values.
-template <typename GridT>
-bool sameGrid(const GridT& a, const GridT& b) {
-    using Leaf = typename GridT::TreeType::LeafNodeType;
-    if (a.tree().leafCount() != b.tree().leafCount() ||
-        a.tree().activeVoxelCount() != b.tree().activeVoxelCount())
-        return false;
-    for (auto it = a.tree().cbeginLeaf(); it; ++it) {
-        const Leaf* other = b.tree().probeConstLeaf(it->origin());
-        if (!other || other->getValueMask() != it->getValueMask() ||
-            std::memcmp(it->buffer().data(), other->buffer().data(),
-                        Leaf::SIZE * sizeof(typename GridT::ValueType)) != 0)
-            return false;
-    }
-    return true;
+/// The same values, bit for bit.
+template <typename T>
+bool sameBits(const std::vector<T>& a, const std::vector<T>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
 }
 
+/// Same blocks (origins, active voxels, value offsets) and bitwise-identical values.
 inline bool sameFiberGrid(const FiberGrid& a, const FiberGrid& b) {
-    if (!sameGrid(*a.density, *b.density) || !sameGrid(*a.orientation, *b.orientation) ||
-        a.hasTensor() != b.hasTensor() || a.typeFraction.size() != b.typeFraction.size())
+    if (a.blocks.size() != b.blocks.size() || a.hasTensor() != b.hasTensor() ||
+        a.typeFraction.size() != b.typeFraction.size())
         return false;
-    for (std::size_t t = 0; t < a.typeFraction.size(); ++t)
-        if (!sameGrid(*a.typeFraction[t], *b.typeFraction[t]))
+    for (std::size_t k = 0; k < a.blocks.size(); ++k)
+        if (a.blocks[k].origin != b.blocks[k].origin || a.blocks[k].first != b.blocks[k].first ||
+            a.blocks[k].active != b.blocks[k].active)
             return false;
-    return !a.hasTensor() ||
-           (sameGrid(*a.tensorDiag, *b.tensorDiag) && sameGrid(*a.tensorOffDiag, *b.tensorOffDiag));
+    for (std::size_t t = 0; t < a.typeFraction.size(); ++t)
+        if (!sameBits(a.typeFraction[t], b.typeFraction[t]))
+            return false;
+    return sameBits(a.density, b.density) && sameBits(a.orientation, b.orientation) &&
+           sameBits(a.tensorDiag, b.tensorDiag) && sameBits(a.tensorOffDiag, b.tensorOffDiag);
 }
 
 /// splatStrands on exactly `threads` TBB threads.

@@ -38,8 +38,8 @@ void GridOptions::validate(const FiberGrid& grid) const {
     if (orientation == OrientationModel::Tensor && !grid.hasTensor())
         throw InputError("the tensor orientation model needs a fiber grid with the orientation "
                          "tensor (voxelize --orientation-tensor)");
-    if (!grid.density || !grid.orientation || !(grid.info.voxelSize > 0))
-        throw InputError("the fiber grid has no density/orientation grids or no voxel size");
+    if (grid.orientation.size() != grid.density.size() || !(grid.info.voxelSize > 0))
+        throw InputError("the fiber grid has no orientation per voxel or no voxel size");
 }
 
 void GridOptions::hashInto(Hasher& hasher) const {
@@ -140,19 +140,16 @@ private:
     GridOptions options_;
 };
 
-using DensityLeaf = openvdb::FloatTree::LeafNodeType;
-
-/// The brick of a fiber grid leaf (its origin is a multiple of 8).
-glm::ivec3 brickOf(const DensityLeaf& leaf) {
-    const openvdb::Coord o = leaf.origin();
-    return glm::ivec3(o.x(), o.y(), o.z()) / BrickVolume::kBrick;
+/// The rates volume's brick of a fiber grid block (both are 8³ voxels).
+glm::ivec3 brickOf(const FiberBlock& block) {
+    static_assert(FiberBlock::kDim == BrickVolume::kBrick);
+    return glm::ivec3(block.origin.x(), block.origin.y(), block.origin.z()) / BrickVolume::kBrick;
 }
 
-/// The density grid's leaves, in the tree's (deterministic) order.
-std::vector<const DensityLeaf*> densityLeaves(const FiberGrid& grid) {
-    std::vector<const DensityLeaf*> leaves;
-    grid.density->tree().getNodes(leaves);
-    return leaves;
+/// A voxel's coordinates in its block.
+glm::ivec3 localOf(const FiberBlock& block, const openvdb::Coord& ijk) {
+    const openvdb::Coord l = ijk - block.origin;
+    return {l.x(), l.y(), l.z()};
 }
 
 /// A grid model's LightWorkspace: the rates volume of the last light.
@@ -166,58 +163,46 @@ struct RatesWorkspace final : LightWorkspace {
 
 BrickVolume GridModel::reserveRates() const {
     BrickVolume volume(grid_.info.voxelSize);
-    const std::vector<const DensityLeaf*> leaves = densityLeaves(grid_);
-    // Bricks reserved serially (their order is the leaves'), voxels in parallel.
-    for (const DensityLeaf* leaf : leaves) {
+    const std::vector<FiberBlock>& blocks = grid_.blocks;
+    // Bricks reserved serially (their order is the blocks'), voxels in parallel.
+    for (const FiberBlock& block : blocks) {
         int lowFaces = 0;
-        for (auto it = leaf->cbeginValueOn(); it; ++it) {
-            const openvdb::Coord l = it.getCoord() - leaf->origin();
-            lowFaces |= (l.x() == 0 ? 4 : 0) | (l.y() == 0 ? 2 : 0) | (l.z() == 0 ? 1 : 0);
-        }
-        volume.reserveBrick(brickOf(*leaf), lowFaces);
+        FiberGrid::forEachVoxelOf(block, [&](std::size_t, const openvdb::Coord& ijk) {
+            const glm::ivec3 l = localOf(block, ijk);
+            lowFaces |= (l.x == 0 ? 4 : 0) | (l.y == 0 ? 2 : 0) | (l.z == 0 ? 1 : 0);
+        });
+        volume.reserveBrick(brickOf(block), lowFaces);
     }
     volume.allocateSlots();
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size(), 16), [&](const auto& range) {
-        for (std::size_t li = range.begin(); li != range.end(); ++li) {
-            const BrickVolume::BrickSet bricks = volume.brickSet(brickOf(*leaves[li]));
-            for (auto it = leaves[li]->cbeginValueOn(); it; ++it) {
-                const openvdb::Coord l = it.getCoord() - leaves[li]->origin();
-                volume.reserveVoxel(bricks, {l.x(), l.y(), l.z()});
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, blocks.size(), 16), [&](const auto& range) {
+            for (std::size_t b = range.begin(); b != range.end(); ++b) {
+                const BrickVolume::BrickSet bricks = volume.brickSet(brickOf(blocks[b]));
+                FiberGrid::forEachVoxelOf(blocks[b], [&](std::size_t, const openvdb::Coord& ijk) {
+                    volume.reserveVoxel(bricks, localOf(blocks[b], ijk));
+                });
             }
-        }
-    });
+        });
     volume.allocateValues();
     return volume;
 }
 
 void GridModel::fillRates(BrickVolume& volume, const Light& light) const {
     const double h = grid_.info.voxelSize;
-    const std::vector<const DensityLeaf*> leaves = densityLeaves(grid_);
+    const std::vector<FiberBlock>& blocks = grid_.blocks;
     const float kD = settings_.fiberScale.ribbonWidth();
     const bool tensor = options_.orientation == OrientationModel::Tensor;
     const bool poisson = options_.estimator == AttenuationEstimator::Poisson;
-    // The orientation grids share the density's topology: read them leaf by leaf.
     const auto vec = [](const openvdb::Vec3s& v) {
         return Vec3f(v.x(), v.y(), v.z());
     };
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size(), 4), [&](const auto& range) {
-        for (std::size_t li = range.begin(); li != range.end(); ++li) {
-            const DensityLeaf& leaf = *leaves[li];
-            const openvdb::Coord origin = leaf.origin();
-            const auto* orientation = grid_.orientation->tree().probeConstLeaf(origin);
-            const auto* diag = tensor ? grid_.tensorDiag->tree().probeConstLeaf(origin) : nullptr;
-            const auto* offDiag =
-                tensor ? grid_.tensorOffDiag->tree().probeConstLeaf(origin) : nullptr;
-            std::array<const DensityLeaf*, kMaxFiberTypes> fraction{};
-            for (std::size_t t = 0; t < grid_.typeFraction.size(); ++t)
-                fraction[t] = grid_.typeFraction[t]->tree().probeConstLeaf(origin);
-            const BrickVolume::BrickSet bricks = volume.brickSet(brickOf(leaf));
-            for (auto it = leaf.cbeginValueOn(); it; ++it) {
-                const openvdb::Index i = it.pos();
-                VoxelFibers fibers{*it, orientation ? vec(orientation->getValue(i)) : Vec3f(0.0f),
-                                   diag ? vec(diag->getValue(i)) : Vec3f(0.0f),
-                                   offDiag ? vec(offDiag->getValue(i)) : Vec3f(0.0f)};
-                const openvdb::Coord c = it.getCoord();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks.size(), 4), [&](const auto& range) {
+        for (std::size_t b = range.begin(); b != range.end(); ++b) {
+            const BrickVolume::BrickSet bricks = volume.brickSet(brickOf(blocks[b]));
+            FiberGrid::forEachVoxelOf(blocks[b], [&](std::size_t i, const openvdb::Coord& c) {
+                const VoxelFibers fibers{grid_.density[i], vec(grid_.orientation[i]),
+                                         tensor ? vec(grid_.tensorDiag[i]) : Vec3f(0.0f),
+                                         tensor ? vec(grid_.tensorOffDiag[i]) : Vec3f(0.0f)};
                 const Vec3f world = Vec3f(float(c.x()), float(c.y()), float(c.z())) * float(h);
                 const Vec3f omega = light.pathFrom(world).omega;
                 // Several fiber types: their rates mixed by the voxel's fractions.
@@ -226,17 +211,16 @@ void GridModel::fillRates(BrickVolume& volume, const Light& light) const {
                     r = expectedRates(fibers, omega, crossings_[0], options_.orientation);
                 } else {
                     for (std::size_t t = 0; t < grid_.typeFraction.size(); ++t)
-                        if (const float f = fraction[t] ? fraction[t]->getValue(i) : 0.0f; f > 0)
+                        if (const float f = grid_.typeFraction[t][i]; f > 0)
                             r += expectedRates(fibers, omega, crossings_[t],
                                                options_.orientation) *
                                  f;
                 }
                 const float scale = fibers.lambda * kD;
-                const openvdb::Coord l = c - origin;
-                volume.set(bricks, {l.x(), l.y(), l.z()},
+                volume.set(bricks, localOf(blocks[b], c),
                            {scale * r.cosTheta, (poisson ? r.wAbsorb : r.wLogA) * scale,
                             r.wBeta2 * scale});
-            }
+            });
         }
     });
 }

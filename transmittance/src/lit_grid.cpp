@@ -8,16 +8,16 @@ namespace hairvox {
 LitGrid evaluateOnFiberGrid(const FiberGrid& grid, const LightGlobalTerm& term) {
     std::vector<openvdb::Coord> coords;
     std::vector<GlobalTermQuery> queries;
-    const openvdb::math::Transform& xform = grid.density->transform();
-    auto orientation = grid.orientation->getConstAccessor();
-    for (auto it = grid.density->cbeginValueOn(); it; ++it) {
-        const openvdb::Coord c = it.getCoord();
-        const openvdb::Vec3d p = xform.indexToWorld(c);
-        const openvdb::Vec3s o = orientation.getValue(c);
+    const auto xform = openvdb::math::Transform::createLinearTransform(grid.info.voxelSize);
+    coords.reserve(grid.activeVoxelCount());
+    queries.reserve(grid.activeVoxelCount());
+    grid.forEachVoxel([&](std::size_t i, const openvdb::Coord& c) {
+        const openvdb::Vec3d p = xform->indexToWorld(c);
+        const openvdb::Vec3s& o = grid.orientation[i];
         coords.push_back(c);
         queries.push_back({Vec3f(float(p.x()), float(p.y()), float(p.z())),
                            normalizeOr(Vec3f(o.x(), o.y(), o.z()), Vec3f(0.0f, 1.0f, 0.0f))});
-    }
+    });
     std::vector<GlobalTerm> terms(queries.size());
     LitGrid lit;
     lit.stats = term.evaluate(queries, terms);
@@ -40,7 +40,7 @@ LitGrid evaluateOnFiberGrid(const FiberGrid& grid, const LightGlobalTerm& term) 
     const auto name = [&](openvdb::GridBase& g, const char* gridName, const char* units,
                           const char* description) {
         g.setName(gridName);
-        g.setTransform(xform.copy());
+        g.setTransform(xform->copy());
         g.setGridClass(openvdb::GRID_UNKNOWN);
         g.insertMeta("units", openvdb::StringMetadata(units));
         g.insertMeta("description", openvdb::StringMetadata(description));

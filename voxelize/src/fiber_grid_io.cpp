@@ -14,8 +14,14 @@
 #include <hairvox/voxelize/fiber_grid.h>
 
 #include <openvdb/io/File.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <memory>
+#include <optional>
 
 namespace hairvox {
 
@@ -166,30 +172,131 @@ bool finiteVec(const openvdb::Vec3s& v) {
     return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
 }
 
+using FloatLeaf = openvdb::FloatTree::LeafNodeType;
+using Vec3SLeaf = openvdb::Vec3STree::LeafNodeType;
+
+/// Bytes of one OpenVDB leaf: the node and its separately allocated values.
+template <typename Leaf>
+std::uint64_t leafBytes() {
+    return sizeof(Leaf) + Leaf::SIZE * sizeof(typename Leaf::ValueType);
+}
+
+/// One quantity of the fiber grid as an OpenVDB grid: a leaf per block.
+template <typename GridT, typename V>
+typename GridT::Ptr vdbGrid(const FiberGrid& grid, const char* name, const std::vector<V>& values) {
+    using Leaf = typename GridT::TreeType::LeafNodeType;
+    using Value = typename GridT::ValueType;
+    std::vector<std::unique_ptr<Leaf>> leaves(grid.blocks.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size(), 64), [&](const auto& r) {
+        for (std::size_t b = r.begin(); b != r.end(); ++b) {
+            const FiberBlock& block = grid.blocks[b];
+            leaves[b] = std::make_unique<Leaf>(block.origin, openvdb::zeroVal<Value>(), false);
+            std::size_t i = block.first;
+            for (auto it = block.active.beginOn(); it; ++it)
+                leaves[b]->setValueOn(it.pos(), Value(values[i++]));
+        }
+    });
+    auto out = GridT::create(openvdb::zeroVal<Value>());
+    out->setName(name);
+    out->setTransform(openvdb::math::Transform::createLinearTransform(grid.info.voxelSize));
+    for (auto& leaf : leaves)
+        out->tree().addLeaf(leaf.release());
+    addMetadata(*out, grid.info);
+    return out;
+}
+
+/// The fiber grid of OpenVDB grids checked by readFiberGrid: the density's
+/// leaves become the blocks, and every grid is read at their active voxels.
+FiberGrid packFiberGrid(const FiberVdbGrids& vdb, FiberGridInfo info, const std::string& file) {
+    std::vector<const FloatLeaf*> leaves;
+    vdb.density->tree().getNodes(leaves);
+    std::erase_if(leaves, [](const FloatLeaf* leaf) { return leaf->isEmpty(); });
+    std::sort(leaves.begin(), leaves.end(),
+              [](const FloatLeaf* a, const FloatLeaf* b) { return a->origin() < b->origin(); });
+    FiberGrid grid;
+    grid.info = std::move(info);
+    std::uint64_t voxels = 0;
+    grid.blocks.reserve(leaves.size());
+    for (const FloatLeaf* leaf : leaves) {
+        if (voxels + leaf->onVoxelCount() > std::numeric_limits<std::uint32_t>::max())
+            throw InputError(strCat(file, ": grid '", kDensityGridName,
+                                    "' has over 2^32 - 1 active voxels, the most a "
+                                    "hairvox fiber grid holds"));
+        grid.blocks.push_back({leaf->origin(), std::uint32_t(voxels), leaf->getValueMask()});
+        voxels += leaf->onVoxelCount();
+    }
+    grid.density.resize(voxels);
+    grid.orientation.resize(voxels);
+    grid.tensorStored = vdb.tensorDiag != nullptr;
+    if (grid.tensorStored) {
+        grid.tensorDiag.resize(voxels);
+        grid.tensorOffDiag.resize(voxels);
+    }
+    grid.typeFraction.assign(vdb.typeFraction.size(), std::vector<float>(voxels));
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size(), 64), [&](const auto& r) {
+        auto orientation = vdb.orientation->getConstAccessor();
+        std::optional<openvdb::Vec3SGrid::ConstAccessor> diag, offDiag;
+        if (grid.tensorStored) {
+            diag.emplace(vdb.tensorDiag->getConstAccessor());
+            offDiag.emplace(vdb.tensorOffDiag->getConstAccessor());
+        }
+        std::vector<openvdb::FloatGrid::ConstAccessor> fractions;
+        for (const auto& fraction : vdb.typeFraction)
+            fractions.push_back(fraction->getConstAccessor());
+        for (std::size_t b = r.begin(); b != r.end(); ++b)
+            FiberGrid::forEachVoxelOf(grid.blocks[b], [&](std::size_t i, const openvdb::Coord& c) {
+                grid.density[i] = leaves[b]->getValue(c);
+                grid.orientation[i] = orientation.getValue(c);
+                if (grid.tensorStored) {
+                    grid.tensorDiag[i] = diag->getValue(c);
+                    grid.tensorOffDiag[i] = offDiag->getValue(c);
+                }
+                for (std::size_t t = 0; t < fractions.size(); ++t)
+                    grid.typeFraction[t][i] = fractions[t].getValue(c);
+            });
+    });
+    return grid;
+}
+
 } // namespace
 
 std::string typeFractionGridName(std::size_t type) {
     return strCat("fiberType", type);
 }
 
-void writeFiberGrid(const std::filesystem::path& path, const FiberGrid& grid) {
-    if (!grid.density || !grid.orientation)
-        throw std::invalid_argument(
-            "writeFiberGrid: the density and orientation grids are required");
+openvdb::GridPtrVec FiberVdbGrids::all() const {
+    openvdb::GridPtrVec grids{density, orientation};
+    if (tensorDiag)
+        grids.insert(grids.end(), {tensorDiag, tensorOffDiag});
+    grids.insert(grids.end(), typeFraction.begin(), typeFraction.end());
+    return grids;
+}
+
+FiberVdbGrids toVdbGrids(const FiberGrid& grid) {
     openvdb::initialize();
-    // Shallow copies (shared trees) carry the metadata, leaving the caller's grids untouched.
-    openvdb::GridPtrVec grids;
-    std::vector<openvdb::GridBase::Ptr> all{
-        grid.density, grid.orientation, grid.tensorDiag, grid.tensorOffDiag};
-    all.insert(all.end(), grid.typeFraction.begin(), grid.typeFraction.end());
-    for (const openvdb::GridBase::Ptr& g : all) {
-        if (!g)
-            continue;
-        openvdb::GridBase::Ptr copy = g->copyGrid();
-        addMetadata(*copy, grid.info);
-        grids.push_back(copy);
+    FiberVdbGrids vdb;
+    vdb.density = vdbGrid<openvdb::FloatGrid>(grid, kDensityGridName, grid.density);
+    vdb.orientation = vdbGrid<openvdb::Vec3SGrid>(grid, kOrientationGridName, grid.orientation);
+    if (grid.hasTensor()) {
+        vdb.tensorDiag = vdbGrid<openvdb::Vec3SGrid>(grid, kTensorDiagGridName, grid.tensorDiag);
+        vdb.tensorOffDiag =
+            vdbGrid<openvdb::Vec3SGrid>(grid, kTensorOffDiagGridName, grid.tensorOffDiag);
     }
-    writeVdbFile(path, grids);
+    for (std::size_t t = 0; t < grid.typeFraction.size(); ++t)
+        vdb.typeFraction.push_back(vdbGrid<openvdb::FloatGrid>(
+            grid, typeFractionGridName(t).c_str(), grid.typeFraction[t]));
+    return vdb;
+}
+
+std::uint64_t vdbMemoryBytes(const FiberGrid& grid) {
+    const std::uint64_t floatGrids = 1 + grid.typeFraction.size();
+    const std::uint64_t vectorGrids = grid.hasTensor() ? 3 : 1;
+    return grid.blocks.size() *
+           (floatGrids * leafBytes<FloatLeaf>() + vectorGrids * leafBytes<Vec3SLeaf>());
+}
+
+void writeFiberGrid(const std::filesystem::path& path, const FiberGrid& grid) {
+    writeVdbFile(path, toVdbGrids(grid).all());
 }
 
 void writeVdbFile(const std::filesystem::path& path, const openvdb::GridPtrVec& grids) {
@@ -208,48 +315,54 @@ void writeVdbFile(const std::filesystem::path& path, const openvdb::GridPtrVec& 
 FiberGrid readFiberGrid(const std::filesystem::path& path) {
     const std::string file = path.string();
     openvdb::initialize();
-    FiberGrid grid;
+    FiberVdbGrids vdb;
+    FiberGridInfo info;
     try {
         openvdb::io::File in(file);
         in.open(/*delayLoad=*/false);
-        grid.density = readGrid<openvdb::FloatGrid>(in, kDensityGridName, file);
-        grid.orientation = readGrid<openvdb::Vec3SGrid>(in, kOrientationGridName, file);
-        grid.tensorDiag = readGrid<openvdb::Vec3SGrid>(in, kTensorDiagGridName, file);
-        grid.tensorOffDiag = readGrid<openvdb::Vec3SGrid>(in, kTensorOffDiagGridName, file);
+        vdb.density = readGrid<openvdb::FloatGrid>(in, kDensityGridName, file);
+        vdb.orientation = readGrid<openvdb::Vec3SGrid>(in, kOrientationGridName, file);
+        vdb.tensorDiag = readGrid<openvdb::Vec3SGrid>(in, kTensorDiagGridName, file);
+        vdb.tensorOffDiag = readGrid<openvdb::Vec3SGrid>(in, kTensorOffDiagGridName, file);
         for (std::size_t t = 0; t < kMaxFiberTypes; ++t) {
             const std::string name = typeFractionGridName(t);
             auto fraction = readGrid<openvdb::FloatGrid>(in, name.c_str(), file);
             if (!fraction)
                 break;
-            grid.typeFraction.push_back(std::move(fraction));
+            vdb.typeFraction.push_back(std::move(fraction));
         }
         in.close();
-        if (!grid.density || !grid.orientation)
+        if (!vdb.density || !vdb.orientation)
             throw InputError(strCat(file, ": a fiber grid needs the grids '", kDensityGridName,
                                     "' and '", kOrientationGridName, "'"));
-        if ((grid.tensorDiag == nullptr) != (grid.tensorOffDiag == nullptr))
+        if ((vdb.tensorDiag == nullptr) != (vdb.tensorOffDiag == nullptr))
             throw InputError(strCat(file, ": the grids '", kTensorDiagGridName, "' and '",
                                     kTensorOffDiagGridName,
                                     "' come together; only one is present"));
-        grid.info = readMetadata(*grid.density, file);
+        info = readMetadata(*vdb.density, file);
 
-        const double h = grid.info.voxelSize;
-        checkTransform(*grid.density, h, file);
-        checkTransform(*grid.orientation, h, file);
-        checkValues(*grid.density, file, "finite and >= 0",
+        const double h = info.voxelSize;
+        checkTransform(*vdb.density, h, file);
+        checkTransform(*vdb.orientation, h, file);
+        checkValues(*vdb.density, file, "finite and >= 0",
                     [](float v) { return std::isfinite(v) && v >= 0; });
-        checkValues(*grid.orientation, file, "finite", finiteVec);
-        if (grid.hasTensor()) {
-            checkTransform(*grid.tensorDiag, h, file);
-            checkTransform(*grid.tensorOffDiag, h, file);
-            checkValues(*grid.tensorDiag, file, "finite", finiteVec);
-            checkValues(*grid.tensorOffDiag, file, "finite", finiteVec);
+        checkValues(*vdb.orientation, file, "finite", finiteVec);
+        if (vdb.density->tree().activeTileCount() > 0)
+            throw InputError(strCat(file, ": grid '", kDensityGridName, "' has ",
+                                    vdb.density->tree().activeTileCount(),
+                                    " active tiles; a fiber grid's active values are leaf "
+                                    "voxels (voxelize the tiles first)"));
+        if (vdb.tensorDiag) {
+            checkTransform(*vdb.tensorDiag, h, file);
+            checkTransform(*vdb.tensorOffDiag, h, file);
+            checkValues(*vdb.tensorDiag, file, "finite", finiteVec);
+            checkValues(*vdb.tensorOffDiag, file, "finite", finiteVec);
         }
-        if (grid.typeFraction.size() == 1)
+        if (vdb.typeFraction.size() == 1)
             throw InputError(strCat(file, ": a single fiber-type fraction grid '",
                                     typeFractionGridName(0),
                                     "'; fractions come for 2 types or more"));
-        for (const auto& fraction : grid.typeFraction) {
+        for (const auto& fraction : vdb.typeFraction) {
             checkTransform(*fraction, h, file);
             checkValues(*fraction, file, "in [0, 1]",
                         [](float v) { return v >= 0 && v <= 1; });
@@ -257,7 +370,7 @@ FiberGrid readFiberGrid(const std::filesystem::path& path) {
     } catch (const openvdb::Exception& e) {
         throw InputError(strCat(file, ": cannot read as a hairvox fiber grid: ", e.what()));
     }
-    return grid;
+    return packFiberGrid(vdb, std::move(info), file);
 }
 
 } // namespace hairvox

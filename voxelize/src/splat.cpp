@@ -12,8 +12,10 @@
 //     voxels and computes them alone, from every cell that touches them (its
 //     own cells and a one-cell apron below, which a neighbour also visits
 //     for its own voxels), in a dense double accumulator of the thread, then
-//     emits OpenVDB leaves. No voxel is written by two bricks: no merge step.
-//  4. The leaves are added to the trees serially (cheap: one per 512 voxels).
+//     emits its blocks of 8³ voxels with their active voxels' values packed.
+//     No voxel is written by two bricks: no merge step.
+//  4. The blocks are sorted by origin and their values gathered into the
+//     grid's arrays (parallel over blocks; a copy of 16 bytes a voxel).
 #include <hairvox/core/error.h>
 #include <hairvox/core/grid_traversal.h>
 #include <hairvox/core/hash.h>
@@ -46,15 +48,13 @@ namespace hairvox {
 
 namespace {
 
-using FloatLeaf = openvdb::FloatTree::LeafNodeType;
-using Vec3SLeaf = openvdb::Vec3STree::LeafNodeType;
 using Vec3i = glm::ivec3;
 /// Two doubles in one SIMD register (GCC/Clang vector extension; plain
 /// scalar code on targets without SIMD). The accumulator's channels are
 /// updated in pairs: the hot loop is otherwise compiled to scalar code.
 using Double2 = double __attribute__((vector_size(2 * sizeof(double))));
 
-constexpr int kLeafDim = static_cast<int>(FloatLeaf::DIM); // 8
+constexpr int kLeafDim = FiberBlock::kDim; // 8: OpenVDB's leaf
 /// Brick side in voxels, a multiple of the leaf size. Measured on the 1.4M
 /// segment wavy groom: 16 gives 2.4M (segment, brick) clips for 1.4M
 /// segments and a slower bucketing, 32 gives 1.8M at the same splat speed,
@@ -351,11 +351,13 @@ struct Channels {
     }
 };
 
-/// The leaves one brick produces.
-struct BrickLeaves {
-    std::vector<std::unique_ptr<FloatLeaf>> density;
-    std::vector<std::unique_ptr<Vec3SLeaf>> orientation, tensorDiag, tensorOffDiag;
-    std::array<std::vector<std::unique_ptr<FloatLeaf>>, kMaxFiberTypes> typeFraction;
+/// The blocks and values one brick produces, laid out as in FiberGrid (a
+/// block's `first` counts from the brick's first value).
+struct BrickVoxels {
+    std::vector<FiberBlock> blocks;
+    std::vector<float> density;
+    std::vector<openvdb::Vec3s> orientation, tensorDiag, tensorOffDiag;
+    std::array<std::vector<float>, kMaxFiberTypes> typeFraction;
 };
 
 /// Dense double sums over one brick and its apron, z fastest (OpenVDB's leaf
@@ -433,12 +435,12 @@ public:
         });
     }
 
-    /// Emits the leaves of the brick's own voxels (local [1, 32]) that hold
+    /// Emits the blocks of the brick's own voxels (local [1, 32]) that hold
     /// fiber, and clears what was touched for the next brick.
-    void extract(const openvdb::Coord& brickOrigin, double invVoxelVolume, BrickLeaves& out) {
+    void extract(const openvdb::Coord& brickOrigin, double invVoxelVolume, BrickVoxels& out) {
         forEachTouchedLeaf([&](const Vec3i& lo) {
-            extractLeaf(lo, brickOrigin + openvdb::Coord(lo.x - 1, lo.y - 1, lo.z - 1),
-                        invVoxelVolume, out);
+            extractBlock(lo, brickOrigin + openvdb::Coord(lo.x - 1, lo.y - 1, lo.z - 1),
+                         invVoxelVolume, out);
         });
         // Only once all are read: a leaf's block is cleared with the apron
         // layer below it (and above it at the brick's top), which overlaps
@@ -506,11 +508,9 @@ private:
         }
     }
 
-    void extractLeaf(const Vec3i& lo, const openvdb::Coord& origin, double invVoxelVolume,
-                     BrickLeaves& out) {
-        std::unique_ptr<FloatLeaf> density;
-        std::unique_ptr<Vec3SLeaf> orientation, diag, offDiag;
-        std::array<std::unique_ptr<FloatLeaf>, kMaxFiberTypes> fraction;
+    void extractBlock(const Vec3i& lo, const openvdb::Coord& origin, double invVoxelVolume,
+                      BrickVoxels& out) {
+        FiberBlock block{origin, static_cast<std::uint32_t>(out.density.size()), {}};
         for (int x = 0; x < kLeafDim; ++x)
             for (int y = 0; y < kLeafDim; ++y)
                 for (int z = 0; z < kLeafDim; ++z) {
@@ -520,49 +520,26 @@ private:
                     // below would lose their precision in denormals.
                     if (!(lambda >= FLT_MIN))
                         continue;
-                    if (!density) {
-                        density = std::make_unique<FloatLeaf>(origin, 0.0f, false);
-                        orientation =
-                            std::make_unique<Vec3SLeaf>(origin, openvdb::Vec3s(0.0f), false);
-                        if constexpr (Tensor) {
-                            diag = std::make_unique<Vec3SLeaf>(origin, openvdb::Vec3s(0.0f), false);
-                            offDiag =
-                                std::make_unique<Vec3SLeaf>(origin, openvdb::Vec3s(0.0f), false);
-                        }
-                        if constexpr (Typed)
-                            for (std::size_t t = 0; t < fiberTypes_; ++t)
-                                fraction[t] = std::make_unique<FloatLeaf>(origin, 0.0f, false);
-                    }
-                    const openvdb::Index offset =
-                        FloatLeaf::coordToOffset(origin + openvdb::Coord(x, y, z));
+                    block.active.setOn(openvdb::Index((x << 6) | (y << 3) | z));
                     const double inv = 1.0 / v[0];
                     const auto mean = [&](std::size_t ch) {
                         return openvdb::Vec3s(static_cast<float>(v[ch] * inv),
                                               static_cast<float>(v[ch + 1] * inv),
                                               static_cast<float>(v[ch + 2] * inv));
                     };
-                    density->setValueOn(offset, lambda);
-                    orientation->setValueOn(offset, mean(1));
+                    out.density.push_back(lambda);
+                    out.orientation.push_back(mean(1));
                     if constexpr (Tensor) {
-                        diag->setValueOn(offset, mean(Ch::kTensorDiag));
-                        offDiag->setValueOn(offset, mean(Ch::kTensorOffDiag));
+                        out.tensorDiag.push_back(mean(Ch::kTensorDiag));
+                        out.tensorOffDiag.push_back(mean(Ch::kTensorOffDiag));
                     }
                     if constexpr (Typed)
                         for (std::size_t t = 0; t < fiberTypes_; ++t)
-                            fraction[t]->setValueOn(
-                                offset, static_cast<float>(v[Ch::kType + t] * inv));
+                            out.typeFraction[t].push_back(
+                                static_cast<float>(v[Ch::kType + t] * inv));
                 }
-        if (!density)
-            return;
-        out.density.push_back(std::move(density));
-        out.orientation.push_back(std::move(orientation));
-        if constexpr (Tensor) {
-            out.tensorDiag.push_back(std::move(diag));
-            out.tensorOffDiag.push_back(std::move(offDiag));
-        }
-        if constexpr (Typed)
-            for (std::size_t t = 0; t < fiberTypes_; ++t)
-                out.typeFraction[t].push_back(std::move(fraction[t]));
+        if (!block.active.isOff())
+            out.blocks.push_back(block);
     }
 
     static int leafBit(int x, int y, int z) {
@@ -585,13 +562,13 @@ private:
 };
 
 template <bool Tensor, bool Typed>
-std::vector<BrickLeaves> splatBricks(const Groom& groom, const BrickBuckets& buckets, double h,
-                                     const FiberScale& scale, std::size_t fiberTypes,
-                                     bool threaded, ProgressReporter& progress) {
+std::vector<BrickVoxels> splatBricks(const Groom& groom, const BrickBuckets& buckets, double h,
+                                     const FiberScale& scale, std::size_t fiberTypes, bool threaded,
+                                     ProgressReporter& progress) {
     const double invH = 1.0 / h, invVoxelVolume = 1.0 / (h * h * h);
     const bool perPointDiameter = !groom.thickness.empty();
     const double invWidth = 1.0 / double(scale.ribbonWidth());
-    std::vector<BrickLeaves> leaves(buckets.bricks.size());
+    std::vector<BrickVoxels> voxels(buckets.bricks.size());
     tbb::enumerable_thread_specific<std::unique_ptr<BrickAccumulator<Tensor, Typed>>> accumulators;
     forEachIndexInOrder(buckets.bricks.size(), threaded, [&](std::size_t k) {
         throwIfInterrupted();
@@ -625,10 +602,10 @@ std::vector<BrickLeaves> splatBricks(const Groom& groom, const BrickBuckets& buc
                                     delta * (1.0 / length), fiberTypeAt(groom, p - 1));
             }
         }
-        acc->extract(origin, invVoxelVolume, leaves[b]);
+        acc->extract(origin, invVoxelVolume, voxels[b]);
         progress.update();
     });
-    return leaves;
+    return voxels;
 }
 
 // ---------------------------------------------------------------------------
@@ -700,25 +677,35 @@ double voxelSizeFromBounds(const Bounds3f& bounds, int voxelsAcross) {
     return longest > 0 ? longest / voxelsAcross : 1.0;
 }
 
-/// Bytes splatStrands needs for `leaves` leaf nodes in each grid, plus the
-/// runs of the bucketing (about one per strand and brick crossing, doubled
-/// for the bricks above that need a brick's last layer) and the accumulators.
+/// A bound on the active voxels: those of `leaves` blocks, or, if fewer, the
+/// 8 corners of each strand's first cell and 4 more for each cell boundary a
+/// segment crosses (at most Σ|Δ|₁/h plus 3 a segment).
+double voxelBound(double leaves, const Groom& groom, const GroomScan& scan, double h) {
+    const double l1 = scan.sumAbsDelta.x + scan.sumAbsDelta.y + scan.sumAbsDelta.z;
+    return std::min(leaves * kLeafDim * kLeafDim * kLeafDim,
+                    8.0 * double(groom.strandCount()) +
+                        4.0 * (l1 / h + 3.0 * double(groom.segmentCount())));
+}
+
+/// Bytes splatStrands needs for `leaves` blocks: their active voxels' values
+/// (voxelBound()) twice — each brick's, then the grid's — and the blocks,
+/// plus the runs of the bucketing (about one per strand and brick crossing,
+/// doubled for the bricks above that need a brick's last layer) and the
+/// accumulators.
 double memoryForLeaves(double leaves, const Groom& groom, const GroomScan& scan, double h,
                        bool tensor, bool threaded) {
     const bool typed = scan.fiberTypes > 1;
-    const double leafBytes =
-        double(1 + (typed ? scan.fiberTypes : 0)) *
-            double(sizeof(FloatLeaf) + FloatLeaf::SIZE * sizeof(float)) +
-        double(tensor ? 3 : 1) *
-            double(sizeof(Vec3SLeaf) + Vec3SLeaf::SIZE * sizeof(openvdb::Vec3s));
+    const double voxelBytes = double(sizeof(float)) * double(1 + (typed ? scan.fiberTypes : 0)) +
+                              double(sizeof(openvdb::Vec3s)) * (tensor ? 3 : 1);
     const double l1 = scan.sumAbsDelta.x + scan.sumAbsDelta.y + scan.sumAbsDelta.z;
     const double runs = 2.0 * (double(groom.strandCount()) + l1 / (h * kBrickSize));
     const double channels = double(tensor ? Channels<true, false>::C : Channels<false, false>::C) +
                             (typed ? double(kMaxFiberTypes) : 0.0);
     const double accumulatorBytes = double(kAccDim) * kAccDim * kAccDim * channels * 8;
     const double threads = threaded ? std::max(1, activeThreadCount()) : 1;
-    return leaves * leafBytes + runs * double(sizeof(ChunkRuns::Entry) + sizeof(Run)) +
-           threads * accumulatorBytes;
+    return 2.0 * (voxelBound(leaves, groom, scan, h) * voxelBytes +
+                  leaves * double(sizeof(FiberBlock))) +
+           runs * double(sizeof(ChunkRuns::Entry) + sizeof(Run)) + threads * accumulatorBytes;
 }
 
 /// Trilinear corners spill into the next leaf on each axis for 1 cell in 8.
@@ -810,25 +797,68 @@ void checkVoxelSizeForGroom(const Groom& groom, const std::vector<StrandRange>& 
     if (bytes > budget) {
         std::ostringstream os;
         os << std::setprecision(3) << "voxelize: voxel size " << h << " would need about "
-           << formatGiB(bytes) << " GiB (estimate: " << leaves
-           << " leaf nodes of 8³ voxels per grid), over the memory budget of " << formatGiB(budget)
+           << formatGiB(bytes) << " GiB (estimate: " << leaves << " blocks of 8³ voxels, "
+           << voxelBound(leaves, groom, scan, h)
+           << " active voxels at most), over the memory budget of " << formatGiB(budget)
            << " GiB; use a larger voxel size (this groom's default is " << defaultH << ")";
         throw InputError(os.str());
     }
 }
 
-template <typename GridT>
-typename GridT::Ptr makeGrid(const char* name, double h) {
-    auto grid = GridT::create();
-    grid->setName(name);
-    grid->setTransform(openvdb::math::Transform::createLinearTransform(h));
-    return grid;
-}
-
-template <typename GridT, typename Leaf>
-void addLeaves(GridT& grid, std::vector<std::unique_ptr<Leaf>>& leaves) {
-    for (auto& leaf : leaves)
-        grid.tree().addLeaf(leaf.release());
+/// Gathers the bricks' blocks into the grid, in lexicographic order of their
+/// origins (a brick's blocks are in that order already, and bricks own
+/// disjoint voxels, so no origin repeats), and frees the bricks' arrays.
+void assembleBricks(std::vector<BrickVoxels>& bricks, std::size_t fiberTypes, bool threaded,
+                    FiberGrid& grid) {
+    struct BlockRef {
+        openvdb::Coord origin;
+        std::uint32_t brick, block;
+    };
+    std::vector<BlockRef> refs;
+    std::uint64_t voxels = 0;
+    for (std::size_t b = 0; b < bricks.size(); ++b) {
+        for (std::size_t k = 0; k < bricks[b].blocks.size(); ++k)
+            refs.push_back({bricks[b].blocks[k].origin, std::uint32_t(b), std::uint32_t(k)});
+        voxels += bricks[b].density.size();
+    }
+    if (voxels > std::numeric_limits<std::uint32_t>::max())
+        throw InputError(strCat("voxelize: ", voxels,
+                                " active voxels; the fiber grid holds up to 2^32 - 1; use a "
+                                "larger voxel size"));
+    std::sort(refs.begin(), refs.end(),
+              [](const BlockRef& a, const BlockRef& b) { return a.origin < b.origin; });
+    grid.blocks.resize(refs.size());
+    std::uint32_t first = 0;
+    for (std::size_t k = 0; k < refs.size(); ++k) {
+        grid.blocks[k] = bricks[refs[k].brick].blocks[refs[k].block];
+        grid.blocks[k].first = first;
+        first += grid.blocks[k].active.countOn();
+    }
+    grid.density.resize(voxels);
+    grid.orientation.resize(voxels);
+    if (grid.tensorStored) {
+        grid.tensorDiag.resize(voxels);
+        grid.tensorOffDiag.resize(voxels);
+    }
+    grid.typeFraction.assign(fiberTypes > 1 ? fiberTypes : 0, std::vector<float>(voxels));
+    forEachIndex(refs.size(), threaded, [&](std::size_t k) {
+        const BrickVoxels& brick = bricks[refs[k].brick];
+        const std::size_t from = brick.blocks[refs[k].block].first, to = grid.blocks[k].first,
+                          n = grid.blocks[k].active.countOn();
+        const auto copy = [&](const auto& source, auto& target) {
+            std::copy_n(source.begin() + std::ptrdiff_t(from), n,
+                        target.begin() + std::ptrdiff_t(to));
+        };
+        copy(brick.density, grid.density);
+        copy(brick.orientation, grid.orientation);
+        if (grid.tensorStored) {
+            copy(brick.tensorDiag, grid.tensorDiag);
+            copy(brick.tensorOffDiag, grid.tensorOffDiag);
+        }
+        for (std::size_t t = 0; t < grid.typeFraction.size(); ++t)
+            copy(brick.typeFraction[t], grid.typeFraction[t]);
+    });
+    std::vector<BrickVoxels>().swap(bricks);
 }
 
 } // namespace
@@ -871,20 +901,10 @@ FiberGrid splatStrands(const Groom& groom, const SplatOptions& options) {
     grid.info.segments = groom.segmentCount();
     grid.info.totalLength = scan.totalLength;
     grid.info.version = version();
-    grid.density = makeGrid<openvdb::FloatGrid>(kDensityGridName, h);
-    grid.density->setGridClass(openvdb::GRID_FOG_VOLUME);
-    grid.orientation = makeGrid<openvdb::Vec3SGrid>(kOrientationGridName, h);
-    if (tensor) {
-        grid.tensorDiag = makeGrid<openvdb::Vec3SGrid>(kTensorDiagGridName, h);
-        grid.tensorOffDiag = makeGrid<openvdb::Vec3SGrid>(kTensorOffDiagGridName, h);
-    }
+    grid.tensorStored = tensor;
     const bool typed = scan.fiberTypes > 1;
     if (typed)
-        for (std::size_t t = 0; t < scan.fiberTypes; ++t) {
-            grid.typeFraction.push_back(
-                makeGrid<openvdb::FloatGrid>(typeFractionGridName(t).c_str(), h));
-            grid.typeFraction.back()->setGridClass(openvdb::GRID_UNKNOWN);
-        }
+        grid.typeFraction.resize(scan.fiberTypes);
     if (!hasLength) {
         grid.warnings.emplace_back(groom.empty()
                                        ? "the groom is empty; the fiber grid is empty"
@@ -899,49 +919,12 @@ FiberGrid splatStrands(const Groom& groom, const SplatOptions& options) {
         return splatBricks<Tensor, Typed>(groom, buckets, h, options.fiberScale, scan.fiberTypes,
                                           options.threaded, progress);
     };
-    std::vector<BrickLeaves> leaves =
+    std::vector<BrickVoxels> bricks =
         tensor ? (typed ? splat.operator()<true, true>() : splat.operator()<true, false>())
                : (typed ? splat.operator()<false, true>() : splat.operator()<false, false>());
     progress.finish();
-    for (BrickLeaves& b : leaves) {
-        addLeaves(*grid.density, b.density);
-        addLeaves(*grid.orientation, b.orientation);
-        if (tensor) {
-            addLeaves(*grid.tensorDiag, b.tensorDiag);
-            addLeaves(*grid.tensorOffDiag, b.tensorOffDiag);
-        }
-        for (std::size_t t = 0; t < grid.typeFraction.size(); ++t)
-            addLeaves(*grid.typeFraction[t], b.typeFraction[t]);
-    }
+    assembleBricks(bricks, scan.fiberTypes, options.threaded, grid);
     return grid;
-}
-
-std::uint64_t FiberGrid::activeVoxelCount() const {
-    return density ? density->activeVoxelCount() : 0;
-}
-
-std::uint64_t FiberGrid::memoryBytes() const {
-    std::uint64_t bytes = 0;
-    for (const openvdb::GridBase* g : std::initializer_list<const openvdb::GridBase*>{
-             density.get(), orientation.get(), tensorDiag.get(), tensorOffDiag.get()})
-        if (g)
-            bytes += g->memUsage();
-    for (const auto& g : typeFraction)
-        bytes += g->memUsage();
-    return bytes;
-}
-
-std::ostream& operator<<(std::ostream& os, const FiberGridInfo& info) {
-    return os << "FiberGridInfo(voxelSize=" << info.voxelSize << ", " << info.fiberScale
-              << ", sourceFile=\"" << info.sourceFile << "\", sourceHash=" << info.sourceHash
-              << ", strands=" << info.strands << ", segments=" << info.segments
-              << ", totalLength=" << info.totalLength << ", version=" << info.version << ")";
-}
-
-std::ostream& operator<<(std::ostream& os, const FiberGrid& grid) {
-    return os << "FiberGrid(" << grid.info << ", activeVoxels=" << grid.activeVoxelCount()
-              << ", tensor=" << (grid.hasTensor() ? "yes" : "no")
-              << ", fiberTypes=" << grid.fiberTypeCount() << ")";
 }
 
 std::ostream& operator<<(std::ostream& os, const SplatOptions& o) {

@@ -60,6 +60,20 @@
 // its background 0. The fiber scale (diameter D, density multiplier k;
 // strands/fiber_scale.h) is recorded for the consumers (optical depth
 // λ·k·D·|ω×u|); λ itself counts modeled strands only.
+//
+// Storage: OpenVDB for files, packed values in memory
+// ----------------------------------------------------
+//   In a .vdb the fiber grid is OpenVDB grids (one per quantity, sharing the
+//   density's topology), for standard tools. In memory it is the same voxels
+//   without OpenVDB's dense leaves: blocks of 8³ voxels (OpenVDB's leaf) that
+//   list their active voxels by a 512-bit mask, and one packed array per
+//   quantity with a value per active voxel. A strand that the voxels resolve
+//   activates ~25 of a leaf's 512 voxels (Ratboy at 0.5 mm), so OpenVDB's
+//   leaves held 260 bytes per active voxel where the packed form holds 16
+//   (λ and E[u]) plus its block's 80: the splat's memory, and the kernel's
+//   zeroing of fresh pages that was most of its time, grow with the active
+//   voxels instead of with the leaves. toVdbGrids() builds the OpenVDB grids
+//   (the .vdb writer's form); readFiberGrid() packs them again.
 #pragma once
 
 #include <hairvox/strands/fiber_scale.h>
@@ -76,7 +90,7 @@
 
 namespace hairvox {
 
-/// Grid names in FiberGrid and in .vdb files.
+/// Grid names in .vdb files.
 inline constexpr const char* kDensityGridName = "density";
 inline constexpr const char* kOrientationGridName = "orientation";
 inline constexpr const char* kTensorDiagGridName = "tensorDiag";
@@ -99,28 +113,63 @@ struct FiberGridInfo {
 
 std::ostream& operator<<(std::ostream& os, const FiberGridInfo& info);
 
+/// One block of 8³ voxels (OpenVDB's leaf node) holding active voxels.
+struct FiberBlock {
+    openvdb::Coord origin;             ///< its first voxel, a multiple of 8 on each axis
+    std::uint32_t first = 0;           ///< index of its first active voxel in the value arrays
+    openvdb::util::NodeMask<3> active; ///< its active voxels by leaf offset, x·64 + y·8 + z
+
+    static constexpr int kDim = 8;
+    /// Index-space coordinates of the voxel at leaf offset `offset`.
+    openvdb::Coord voxel(openvdb::Index offset) const {
+        return origin + openvdb::Coord(int(offset >> 6), int(offset >> 3 & 7), int(offset & 7));
+    }
+};
+
+/// The fiber grid in memory (see "Storage" above): its blocks in
+/// lexicographic order of their origins, and per active voxel — block by
+/// block, each block's in offset order — one value of each quantity.
 struct FiberGrid {
-    /// "density": λ, fiber length per unit volume (1/length²); GRID_FOG_VOLUME, background 0.
-    openvdb::FloatGrid::Ptr density;
-    /// "orientation": E[u], length-weighted mean unit tangent (root → tip), |·| ∈ [0, 1].
-    openvdb::Vec3SGrid::Ptr orientation;
-    /// "tensorDiag", "tensorOffDiag": E[u uᵀ] as (xx, yy, zz) and (xy, xz, yz);
-    /// both null when not stored (SplatOptions::storeOrientationTensor).
-    openvdb::Vec3SGrid::Ptr tensorDiag, tensorOffDiag;
-    /// "fiberType<t>": f_t, the fraction of fiber type t (see above); one grid
-    /// per type for a groom with more than one type, empty otherwise.
-    std::vector<openvdb::FloatGrid::Ptr> typeFraction;
+    std::vector<FiberBlock> blocks;
+    /// λ, fiber length per unit volume (1/length²).
+    std::vector<float> density;
+    /// E[u], length-weighted mean unit tangent (root → tip), |·| ∈ [0, 1].
+    std::vector<openvdb::Vec3s> orientation;
+    /// E[u uᵀ] as (xx, yy, zz) and (xy, xz, yz); filled when tensorStored.
+    std::vector<openvdb::Vec3s> tensorDiag, tensorOffDiag;
+    bool tensorStored = false; ///< SplatOptions::storeOrientationTensor, or the file had it
+    /// f_t, the fraction of fiber type t, one array per type for a groom with
+    /// more than one type (see above); empty otherwise.
+    std::vector<std::vector<float>> typeFraction;
     FiberGridInfo info;
     /// Notes for the user from splatStrands (e.g. an empty groom); not stored in files.
     std::vector<std::string> warnings;
 
-    bool hasTensor() const { return tensorDiag != nullptr && tensorOffDiag != nullptr; }
-    /// Fiber types the grid distinguishes (1 when it has no fraction grids).
+    /// What find() returns for a voxel that is not active.
+    static constexpr std::size_t kInactive = SIZE_MAX;
+
+    bool hasTensor() const { return tensorStored; }
+    /// Fiber types the grid distinguishes (1 when it has no fractions).
     std::size_t fiberTypeCount() const { return std::max<std::size_t>(1, typeFraction.size()); }
-    /// Active voxels of the density grid (the other grids share its topology).
-    std::uint64_t activeVoxelCount() const;
-    /// In-memory size of all grids, bytes.
+    std::uint64_t activeVoxelCount() const { return density.size(); }
+    /// In-memory size of the blocks and values, bytes.
     std::uint64_t memoryBytes() const;
+    /// The value index of voxel `ijk` (index space), or kInactive. O(log blocks).
+    std::size_t find(const openvdb::Coord& ijk) const;
+
+    /// f(value index, ijk) for every active voxel of `block`, in offset order.
+    template <typename F>
+    static void forEachVoxelOf(const FiberBlock& block, const F& f) {
+        std::size_t i = block.first;
+        for (auto it = block.active.beginOn(); it; ++it)
+            f(i++, block.voxel(it.pos()));
+    }
+    /// f(value index, ijk) for every active voxel, in the arrays' order.
+    template <typename F>
+    void forEachVoxel(const F& f) const {
+        for (const FiberBlock& block : blocks)
+            forEachVoxelOf(block, f);
+    }
 };
 
 std::ostream& operator<<(std::ostream& os, const FiberGrid& grid);
@@ -164,7 +213,26 @@ std::ostream& operator<<(std::ostream& os, const SplatOptions& options);
 /// estimate). Polls throwIfInterrupted().
 FiberGrid splatStrands(const Groom& groom, const SplatOptions& options);
 
-/// Writes the grids with their metadata as one .vdb file, atomically.
+/// The fiber grid as OpenVDB grids: the grids a .vdb file holds, with their
+/// names, transforms, classes and metadata (FiberGridInfo, units, description).
+struct FiberVdbGrids {
+    openvdb::FloatGrid::Ptr density;
+    openvdb::Vec3SGrid::Ptr orientation;
+    openvdb::Vec3SGrid::Ptr tensorDiag, tensorOffDiag; ///< null without the tensor
+    std::vector<openvdb::FloatGrid::Ptr> typeFraction;
+
+    /// Every grid, in the file's order.
+    openvdb::GridPtrVec all() const;
+};
+
+/// Builds the OpenVDB grids of `grid` (a leaf per block, in parallel; the
+/// same grids for any thread count).
+FiberVdbGrids toVdbGrids(const FiberGrid& grid);
+
+/// Bytes toVdbGrids(grid) allocates: its leaves, dense 8³ each.
+std::uint64_t vdbMemoryBytes(const FiberGrid& grid);
+
+/// Writes toVdbGrids(grid) as one .vdb file, atomically.
 void writeFiberGrid(const std::filesystem::path& path, const FiberGrid& grid);
 
 /// Writes OpenVDB grids as one .vdb file through writeFileAtomically() (every
@@ -173,8 +241,10 @@ void writeVdbFile(const std::filesystem::path& path, const openvdb::GridPtrVec& 
 
 /// Reads a .vdb written by writeFiberGrid. Throws InputError naming the file if
 /// it is unreadable, lacks the density or orientation grid or the hairvox
-/// metadata, has a transform other than the vertex-centred linear one, or holds
-/// non-finite or negative density values.
+/// metadata, has a transform other than the vertex-centred linear one, holds
+/// non-finite or negative density values, or active tiles (a fiber grid's
+/// voxels are leaf voxels). The other grids are read at the density's active
+/// voxels.
 FiberGrid readFiberGrid(const std::filesystem::path& path);
 
 } // namespace hairvox
