@@ -104,7 +104,7 @@ void GridForLightRatboy(benchmark::State& state) {
     state.counters["MB_held"] = double(bytes) * 1e-6;
     state.counters["bytes_per_voxel"] = double(bytes) / voxels;
     state.counters["ns_per_voxel"] = seconds * 1e9 / double(state.iterations()) / voxels;
-    // The fiber grid the light reads: OpenVDB's leaves are dense 8³ blocks.
+    // The fiber grid the light reads (packed: voxelize/fiber_grid.h, "Storage").
     state.counters["grid_bytes_per_voxel"] = double(grid.memoryBytes()) / voxels;
 }
 BENCHMARK(GridForLightRatboy)

@@ -5,7 +5,7 @@
 //
 //   build/<dir>/bench/voxelize_bench --benchmark_counters_tabular=true
 //
-// Counters: segments_per_s; voxels (active); grid_MiB (OpenVDB memUsage);
+// Counters: segments_per_s; voxels (active); grid_MiB (FiberGrid::memoryBytes);
 // peak_MiB (resident-set high-water mark during the splat, above the RSS
 // before it: the splat's transient memory plus the grid).
 #include <hairvox/core/parallel.h>

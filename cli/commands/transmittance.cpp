@@ -50,7 +50,7 @@ void runTransmittance(const TransmittanceOptions& opt) {
         splat.voxelSize = scene.voxelSize.value_or(0.0f);
         splat.fiberScale = scene.fiberScale;
         splat.sourceFile = scene.groom.file.string();
-        assets->grid = splatStrands(assets->groom.groom, splat);
+        assets->grid = std::make_shared<const FiberGrid>(splatStrands(assets->groom.groom, splat));
     }
     const LitGrid lit = evaluateOnFiberGrid(*assets->grid, *assets->globalTerm->forLight(light));
     const auto evaluated = std::chrono::steady_clock::now();

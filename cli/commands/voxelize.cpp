@@ -64,6 +64,7 @@ void runVoxelize(const VoxelizeOptions& opt) {
     splat.fiberScale = opt.fiberScale;
     splat.storeOrientationTensor = opt.tensor;
     splat.memoryBudgetBytes = static_cast<std::uint64_t>(opt.memoryBudgetGiB * double(1ull << 30));
+    splat.forVdbFile = true;
     splat.sourceFile = opt.input;
     splat.showProgress = stderrIsTerminal();
     start = std::chrono::steady_clock::now();
@@ -73,7 +74,9 @@ void runVoxelize(const VoxelizeOptions& opt) {
         std::fprintf(stderr, "hairvox: warning: %s: %s\n", opt.input.c_str(), w.c_str());
 
     // The file is OpenVDB's grids, whose dense leaves the packed grid does
-    // not have: refuse before building them what the budget cannot hold.
+    // not have. The splat refused what its estimate of them could not fit;
+    // now that the blocks are counted, refuse before building them what the
+    // budget cannot hold.
     const std::uint64_t vdbBytes = vdbMemoryBytes(grid);
     if (grid.memoryBytes() + vdbBytes > splat.memoryBudgetBytes)
         throw InputError(strCat(opt.output, ": writing the fiber grid needs its OpenVDB leaves, ",

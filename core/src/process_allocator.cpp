@@ -11,8 +11,10 @@
 // measured on, a page's first touch is the cost — the kernel's fault and its
 // zeroing, ~1.5 ns a byte on this VM (machine_bench FirstTouch). glibc's
 // malloc serves its heaps in 4 KiB pages, faulted one by one: the fiber
-// grid's OpenVDB leaves (a 2 KB and a 6 KB buffer each, ~100k of them on
-// Ratboy at 0.5 mm) took 1.2 s of the 1.3 s voxelization there. jemalloc with
+// grid's OpenVDB leaves, when it was kept as OpenVDB grids (a 2 KB and a 6 KB
+// buffer each, ~100k of them on Ratboy at 0.5 mm), took 1.2 s of the 1.3 s
+// voxelization there, and the light caches and rates volumes are allocated
+// the same way (tens to hundreds of MB, once per render). jemalloc with
 // thp:always advises its extents to the kernel as transparent huge pages (one
 // fault per 2 MiB; used where /sys/kernel/mm/transparent_hugepage/enabled says
 // "madvise" or "always"), and keeps what is freed for later allocations for

@@ -320,7 +320,8 @@ FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, Sc
             if (reuse)
                 reuse->release();
             start = Clock::now();
-            assets->grid = splatStrands(assets->groom.groom, splat);
+            assets->grid =
+                std::make_shared<const FiberGrid>(splatStrands(assets->groom.groom, splat));
             assets->times.voxelize = secondsSince(start);
         }
     }
@@ -332,7 +333,7 @@ FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, Sc
             out.reused = reuse->assets.get();
             return out;
         }
-        if (out.gridReused) // the VDB grids are shared, not copied
+        if (out.gridReused) // shared, not copied
             assets->grid = reuse->assets->grid;
         reuse->release();
     }

@@ -107,8 +107,8 @@ TEST(VdbMetadata, FiberGridIsSelfDescribing) {
 
 TEST(VdbMetadata, VoxelizeRefusesAFileItsBudgetCannotBuild) {
     // At 1 mm Ratboy's packed grid (~20 MB) fits 0.1 GiB, the OpenVDB leaves
-    // its file needs (~180 MB, dense 8³ each) do not: refused before they
-    // are built, and no file is left.
+    // its file needs (~180 MB, dense 8³ each) do not: refused before the
+    // splat, by its estimate of them, and no file is left.
     test::TempDir dir;
     const fs::path vdb = dir / "fibers.vdb";
     const auto r = test::runHairvox("voxelize " + quoted(test::dataDir() / "Ratboy_mohawk.tfx") +

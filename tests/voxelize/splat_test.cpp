@@ -443,8 +443,9 @@ TEST(Splat, RefusesAVoxelSizeOverTheMemoryBudgetStatingTheEstimate) {
 }
 
 TEST(Splat, AcceptsFineVoxelsThatFitTheBudget) {
-    // At 700 voxels across, the leaves of the bounding box alone would need
-    // ~2 GiB; the hair of 1,000 strands needs far less and fits 1 GiB.
+    // At 700 voxels across, the bounding box's blocks, were they all full,
+    // would need ~3 GiB; the hair of 1,000 strands needs far less and fits
+    // 1 GiB.
     ProceduralGroomParams p;
     p.strands = 1000;
     const Groom groom = generateGroom(p);
@@ -552,6 +553,7 @@ TEST(Splat, FiberTypesGetFractionsThatSumToOneAndSurviveTheVdbFile) {
     untyped.fiberType.clear();
     const FiberGrid plain = splatStrands(untyped, withVoxelSize(0.02));
     EXPECT_TRUE(plain.typeFraction.empty());
+    EXPECT_TRUE(test::sameBlocks(plain, grid));
     EXPECT_TRUE(test::sameBits(plain.density, grid.density));
 
     test::TempDir dir;

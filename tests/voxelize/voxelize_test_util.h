@@ -33,18 +33,27 @@ inline double exactLength(const Groom& groom) {
 /// The same values, bit for bit.
 template <typename T>
 bool sameBits(const std::vector<T>& a, const std::vector<T>& b) {
-    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
+    // An empty vector's data() may be null, which memcmp may not be given.
+    return a.size() == b.size() &&
+           (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
 }
 
-/// Same blocks (origins, active voxels, value offsets) and bitwise-identical values.
-inline bool sameFiberGrid(const FiberGrid& a, const FiberGrid& b) {
-    if (a.blocks.size() != b.blocks.size() || a.hasTensor() != b.hasTensor() ||
-        a.typeFraction.size() != b.typeFraction.size())
+/// Same blocks: origins, active voxels, value offsets.
+inline bool sameBlocks(const FiberGrid& a, const FiberGrid& b) {
+    if (a.blocks.size() != b.blocks.size())
         return false;
     for (std::size_t k = 0; k < a.blocks.size(); ++k)
         if (a.blocks[k].origin != b.blocks[k].origin || a.blocks[k].first != b.blocks[k].first ||
             a.blocks[k].active != b.blocks[k].active)
             return false;
+    return true;
+}
+
+/// Same blocks and bitwise-identical values.
+inline bool sameFiberGrid(const FiberGrid& a, const FiberGrid& b) {
+    if (!sameBlocks(a, b) || a.hasTensor() != b.hasTensor() ||
+        a.typeFraction.size() != b.typeFraction.size())
+        return false;
     for (std::size_t t = 0; t < a.typeFraction.size(); ++t)
         if (!sameBits(a.typeFraction[t], b.typeFraction[t]))
             return false;

@@ -38,8 +38,18 @@ void GridOptions::validate(const FiberGrid& grid) const {
     if (orientation == OrientationModel::Tensor && !grid.hasTensor())
         throw InputError("the tensor orientation model needs a fiber grid with the orientation "
                          "tensor (voxelize --orientation-tensor)");
-    if (grid.orientation.size() != grid.density.size() || !(grid.info.voxelSize > 0))
-        throw InputError("the fiber grid has no orientation per voxel or no voxel size");
+    const std::size_t voxels = grid.density.size();
+    const bool fractionPerVoxel = std::all_of(grid.typeFraction.begin(), grid.typeFraction.end(),
+                                              [&](const auto& f) { return f.size() == voxels; });
+    if (grid.orientation.size() != voxels ||
+        (grid.hasTensor() &&
+         (grid.tensorDiag.size() != voxels || grid.tensorOffDiag.size() != voxels)) ||
+        !fractionPerVoxel ||
+        (!grid.blocks.empty() &&
+         grid.blocks.back().first + grid.blocks.back().active.countOn() != voxels) ||
+        !(grid.info.voxelSize > 0))
+        throw InputError("the fiber grid's arrays do not hold a value per active voxel, or it "
+                         "has no voxel size");
 }
 
 void GridOptions::hashInto(Hasher& hasher) const {

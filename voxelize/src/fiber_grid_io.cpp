@@ -288,11 +288,12 @@ FiberVdbGrids toVdbGrids(const FiberGrid& grid) {
     return vdb;
 }
 
+std::uint64_t vdbBlockBytes(bool tensor, std::size_t typeFractions) {
+    return (1 + typeFractions) * leafBytes<FloatLeaf>() + (tensor ? 3 : 1) * leafBytes<Vec3SLeaf>();
+}
+
 std::uint64_t vdbMemoryBytes(const FiberGrid& grid) {
-    const std::uint64_t floatGrids = 1 + grid.typeFraction.size();
-    const std::uint64_t vectorGrids = grid.hasTensor() ? 3 : 1;
-    return grid.blocks.size() *
-           (floatGrids * leafBytes<FloatLeaf>() + vectorGrids * leafBytes<Vec3SLeaf>());
+    return grid.blocks.size() * vdbBlockBytes(grid.hasTensor(), grid.typeFraction.size());
 }
 
 void writeFiberGrid(const std::filesystem::path& path, const FiberGrid& grid) {

@@ -370,10 +370,13 @@ public:
     static_assert(C % 2 == 0, "channels are updated in pairs");
     static_assert(kLeavesPerBrickSide * kLeavesPerBrickSide * kLeavesPerBrickSide <= 64,
                   "touchedLeaves_ has one bit per leaf");
+    static constexpr std::size_t kVoxels = std::size_t(kAccDim) * kAccDim * kAccDim;
 
     /// `fiberTypes`: how many type fractions to emit (Typed only).
     explicit BrickAccumulator(std::size_t fiberTypes)
-        : sums_(std::size_t(kAccDim) * kAccDim * kAccDim * C, 0.0)
+        : sums_(kVoxels * C, 0.0)
+        , touchedCells_((kVoxels + 63) / 64, 0)
+        , touchedVoxels_((kVoxels + 63) / 64, 0)
         , fiberTypes_(fiberTypes) {}
 
     /// Adds segment s (in local index space) of weighted world length
@@ -403,20 +406,6 @@ public:
             channel[j] = Double2{values[2 * j], values[2 * j + 1]};
 
         const Vec3i cellMin(0), cellMax(kBrickSize);
-        // Mark the leaves whose voxels the segment's box of cell corners reaches.
-        Vec3i leafLo, leafHi;
-        for (int i = 0; i < 3; ++i) {
-            const auto cellAt = [&](double t) {
-                return std::clamp(hairvox::floorToInt(s.origin[i] + t * s.dir[i]), 0, kBrickSize);
-            };
-            const int c0 = cellAt(t0), c1 = cellAt(t1);
-            leafLo[i] = (std::max(std::min(c0, c1), 1) - 1) / kLeafDim;
-            leafHi[i] = (std::min(std::max(c0, c1) + 1, kBrickSize) - 1) / kLeafDim;
-        }
-        for (int x = leafLo.x; x <= leafHi.x; ++x)
-            for (int y = leafLo.y; y <= leafHi.y; ++y)
-                for (int z = leafLo.z; z <= leafHi.z; ++z)
-                    touchedLeaves_ |= std::uint64_t(1) << leafBit(x, y, z);
         // The fractions inside the current cell are carried from piece to
         // piece: they advance by (tB − tA)·d, and an axis whose cell boundary
         // was crossed restarts exactly at 0 (stepping up) or 1 (down), so
@@ -436,25 +425,40 @@ public:
     }
 
     /// Emits the blocks of the brick's own voxels (local [1, 32]) that hold
-    /// fiber, and clears what was touched for the next brick.
+    /// fiber, and clears what was touched for the next brick. Its work is
+    /// per voxel touched, not per block: at fine voxels a block a strand
+    /// passes holds a few dozen of its 512 voxels.
     void extract(const openvdb::Coord& brickOrigin, double invVoxelVolume, BrickVoxels& out) {
+        // The voxels the touched cells' corners are (every value was added
+        // there), and of them the brick's own, by leaf.
+        constexpr std::size_t dz = 1, dy = kAccDim, dx = dy * kAccDim;
+        forEachBit(touchedCells_, [&](std::size_t cell) {
+            for (const std::size_t corner :
+                 {std::size_t(0), dz, dy, dy + dz, dx, dx + dz, dx + dy, dx + dy + dz})
+                touchedVoxels_[(cell + corner) >> 6] |= std::uint64_t(1) << ((cell + corner) & 63);
+        });
+        forEachBit(touchedVoxels_, [&](std::size_t voxel) {
+            // Local voxel (x, y, z) − 1 in the brick's own [0, 31]³, or outside it (the apron).
+            const auto x = int(voxel / dx) - 1, y = int(voxel / dy % kAccDim) - 1,
+                       z = int(voxel % kAccDim) - 1;
+            if (std::min({x, y, z}) < 0 || std::max({x, y, z}) >= kBrickSize)
+                return;
+            const int leaf = leafBit(x / kLeafDim, y / kLeafDim, z / kLeafDim);
+            touchedLeaves_ |= std::uint64_t(1) << leaf;
+            leafVoxels_[std::size_t(leaf)].setOn(
+                openvdb::Index((x % kLeafDim) << 6 | (y % kLeafDim) << 3 | (z % kLeafDim)));
+        });
         forEachTouchedLeaf([&](const Vec3i& lo) {
-            extractBlock(lo, brickOrigin + openvdb::Coord(lo.x - 1, lo.y - 1, lo.z - 1),
+            auto& voxels = leafVoxels_[std::size_t(
+                leafBit(lo.x / kLeafDim, lo.y / kLeafDim, lo.z / kLeafDim))];
+            extractBlock(lo, voxels, brickOrigin + openvdb::Coord(lo.x - 1, lo.y - 1, lo.z - 1),
                          invVoxelVolume, out);
+            voxels.setOff();
         });
-        // Only once all are read: a leaf's block is cleared with the apron
-        // layer below it (and above it at the brick's top), which overlaps
-        // the neighbouring leaf. A corner reached above a leaf belongs to the
-        // next leaf, which the segment's corner box marked too.
-        forEachTouchedLeaf([&](const Vec3i& lo) {
-            const Vec3i hi =
-                lo + (kLeafDim - 1) + Vec3i(glm::equal(lo + (kLeafDim - 1), Vec3i(kBrickSize)));
-            for (int x = lo.x - 1; x <= hi.x; ++x)
-                for (int y = lo.y - 1; y <= hi.y; ++y) {
-                    double* row = &sums_[index(x, y, lo.z - 1)];
-                    std::fill(row, row + std::size_t(hi.z - lo.z + 2) * C, 0.0);
-                }
-        });
+        forEachBit(touchedVoxels_,
+                   [&](std::size_t voxel) { std::fill_n(&sums_[voxel * C], C, 0.0); });
+        std::fill(touchedCells_.begin(), touchedCells_.end(), 0);
+        std::fill(touchedVoxels_.begin(), touchedVoxels_.end(), 0);
         touchedLeaves_ = 0;
     }
 
@@ -480,7 +484,9 @@ private:
         // (Q0, Q1) of the (Y, Z) pairs (0,0), (0,1), (1,0), (1,1).
         const double q0[4] = {1 - y0 - z0 + pq0, z0 - pq0, y0 - pq0, pq0};
         const double q1[4] = {0.5 - y1 - z1 + pq1, z1 - pq1, y1 - pq1, pq1};
-        double* base = &sums_[index(cell.x, cell.y, cell.z)];
+        const std::size_t cellIndex = index(cell.x, cell.y, cell.z) / C;
+        touchedCells_[cellIndex >> 6] |= std::uint64_t(1) << (cellIndex & 63);
+        double* base = &sums_[cellIndex * C];
         constexpr std::size_t dz = C, dy = std::size_t(kAccDim) * C, dx = dy * kAccDim;
         constexpr std::size_t yzOffset[4] = {0, dz, dy, dy + dz};
         // Weights that are 0 in exact arithmetic can come out as ±1e-16: they
@@ -508,42 +514,51 @@ private:
         }
     }
 
-    void extractBlock(const Vec3i& lo, const openvdb::Coord& origin, double invVoxelVolume,
-                      BrickVoxels& out) {
+    /// The block at `origin` (local voxel `lo`) of the `touched` voxels
+    /// whose λ is at least FLT_MIN, their values appended to `out`.
+    void extractBlock(const Vec3i& lo, const openvdb::util::NodeMask<3>& touched,
+                      const openvdb::Coord& origin, double invVoxelVolume, BrickVoxels& out) {
         FiberBlock block{origin, static_cast<std::uint32_t>(out.density.size()), {}};
-        for (int x = 0; x < kLeafDim; ++x)
-            for (int y = 0; y < kLeafDim; ++y)
-                for (int z = 0; z < kLeafDim; ++z) {
-                    const double* v = &sums_[index(lo.x + x, lo.y + y, lo.z + z)];
-                    const auto lambda = static_cast<float>(v[0] * invVoxelVolume);
-                    // Below FLT_MIN λ is physically nothing, and the ratios
-                    // below would lose their precision in denormals.
-                    if (!(lambda >= FLT_MIN))
-                        continue;
-                    block.active.setOn(openvdb::Index((x << 6) | (y << 3) | z));
-                    const double inv = 1.0 / v[0];
-                    const auto mean = [&](std::size_t ch) {
-                        return openvdb::Vec3s(static_cast<float>(v[ch] * inv),
-                                              static_cast<float>(v[ch + 1] * inv),
-                                              static_cast<float>(v[ch + 2] * inv));
-                    };
-                    out.density.push_back(lambda);
-                    out.orientation.push_back(mean(1));
-                    if constexpr (Tensor) {
-                        out.tensorDiag.push_back(mean(Ch::kTensorDiag));
-                        out.tensorOffDiag.push_back(mean(Ch::kTensorOffDiag));
-                    }
-                    if constexpr (Typed)
-                        for (std::size_t t = 0; t < fiberTypes_; ++t)
-                            out.typeFraction[t].push_back(
-                                static_cast<float>(v[Ch::kType + t] * inv));
-                }
+        for (auto it = touched.beginOn(); it; ++it) {
+            const openvdb::Index offset = it.pos();
+            const double* v = &sums_[index(lo.x + int(offset >> 6), lo.y + int(offset >> 3 & 7),
+                                           lo.z + int(offset & 7))];
+            const auto lambda = static_cast<float>(v[0] * invVoxelVolume);
+            // Below FLT_MIN λ is physically nothing, and the ratios
+            // below would lose their precision in denormals.
+            if (!(lambda >= FLT_MIN))
+                continue;
+            block.active.setOn(offset);
+            const double inv = 1.0 / v[0];
+            const auto mean = [&](std::size_t ch) {
+                return openvdb::Vec3s(static_cast<float>(v[ch] * inv),
+                                      static_cast<float>(v[ch + 1] * inv),
+                                      static_cast<float>(v[ch + 2] * inv));
+            };
+            out.density.push_back(lambda);
+            out.orientation.push_back(mean(1));
+            if constexpr (Tensor) {
+                out.tensorDiag.push_back(mean(Ch::kTensorDiag));
+                out.tensorOffDiag.push_back(mean(Ch::kTensorOffDiag));
+            }
+            if constexpr (Typed)
+                for (std::size_t t = 0; t < fiberTypes_; ++t)
+                    out.typeFraction[t].push_back(static_cast<float>(v[Ch::kType + t] * inv));
+        }
         if (!block.active.isOff())
             out.blocks.push_back(block);
     }
 
     static int leafBit(int x, int y, int z) {
         return (x * kLeavesPerBrickSide + y) * kLeavesPerBrickSide + z;
+    }
+
+    /// f(i) for every bit i set in `bits`, in increasing order.
+    template <typename F>
+    static void forEachBit(const std::vector<std::uint64_t>& bits, const F& f) {
+        for (std::size_t w = 0; w < bits.size(); ++w)
+            for (std::uint64_t word = bits[w]; word != 0; word &= word - 1)
+                f(w * 64 + std::size_t(__builtin_ctzll(word)));
     }
 
     /// f(first local voxel of the leaf) for every marked leaf.
@@ -557,6 +572,11 @@ private:
     }
 
     std::vector<double> sums_;
+    /// Cells that received a piece since the last extract, a bit each by the
+    /// index of their lowest corner; the voxels they reach, found by extract.
+    std::vector<std::uint64_t> touchedCells_, touchedVoxels_;
+    /// The brick's own touched voxels by leaf (leafBit()), found by extract.
+    std::array<openvdb::util::NodeMask<3>, 64> leafVoxels_{};
     std::size_t fiberTypes_;
     std::uint64_t touchedLeaves_ = 0; ///< leaves marked since the last extract, by leafBit()
 };
@@ -688,12 +708,13 @@ double voxelBound(double leaves, const Groom& groom, const GroomScan& scan, doub
 }
 
 /// Bytes splatStrands needs for `leaves` blocks: their active voxels' values
-/// (voxelBound()) twice — each brick's, then the grid's — and the blocks,
-/// plus the runs of the bucketing (about one per strand and brick crossing,
-/// doubled for the bricks above that need a brick's last layer) and the
-/// accumulators.
+/// (voxelBound()) three times — each brick's arrays with their growth's
+/// slack, then the grid's — and the blocks, plus the runs of the bucketing
+/// (about one per strand and brick crossing, doubled for the bricks above
+/// that need a brick's last layer) and the accumulators; with `vdbFile`,
+/// also the leaves of the grid's .vdb (toVdbGrids).
 double memoryForLeaves(double leaves, const Groom& groom, const GroomScan& scan, double h,
-                       bool tensor, bool threaded) {
+                       bool tensor, bool threaded, bool vdbFile) {
     const bool typed = scan.fiberTypes > 1;
     const double voxelBytes = double(sizeof(float)) * double(1 + (typed ? scan.fiberTypes : 0)) +
                               double(sizeof(openvdb::Vec3s)) * (tensor ? 3 : 1);
@@ -703,9 +724,12 @@ double memoryForLeaves(double leaves, const Groom& groom, const GroomScan& scan,
                             (typed ? double(kMaxFiberTypes) : 0.0);
     const double accumulatorBytes = double(kAccDim) * kAccDim * kAccDim * channels * 8;
     const double threads = threaded ? std::max(1, activeThreadCount()) : 1;
-    return 2.0 * (voxelBound(leaves, groom, scan, h) * voxelBytes +
+    const double vdbBytes =
+        vdbFile ? double(vdbBlockBytes(tensor, typed ? scan.fiberTypes : 0)) * leaves : 0.0;
+    return 3.0 * (voxelBound(leaves, groom, scan, h) * voxelBytes +
                   leaves * double(sizeof(FiberBlock))) +
-           runs * double(sizeof(ChunkRuns::Entry) + sizeof(Run)) + threads * accumulatorBytes;
+           runs * double(sizeof(ChunkRuns::Entry) + sizeof(Run)) + threads * accumulatorBytes +
+           vdbBytes;
 }
 
 /// Trilinear corners spill into the next leaf on each axis for 1 cell in 8.
@@ -787,7 +811,7 @@ void checkVoxelSizeForGroom(const Groom& groom, const std::vector<StrandRange>& 
     const auto budget = double(options.memoryBudgetBytes);
     const auto bytesFor = [&](double leaves) {
         return memoryForLeaves(leaves, groom, scan, h, options.storeOrientationTensor,
-                               options.threaded);
+                               options.threaded, options.forVdbFile);
     };
     double leaves = leafBound(groom, scan, h);
     // Within 16× of the budget the bound may just be loose: count instead.
@@ -798,8 +822,9 @@ void checkVoxelSizeForGroom(const Groom& groom, const std::vector<StrandRange>& 
         std::ostringstream os;
         os << std::setprecision(3) << "voxelize: voxel size " << h << " would need about "
            << formatGiB(bytes) << " GiB (estimate: " << leaves << " blocks of 8³ voxels, "
-           << voxelBound(leaves, groom, scan, h)
-           << " active voxels at most), over the memory budget of " << formatGiB(budget)
+           << voxelBound(leaves, groom, scan, h) << " active voxels at most"
+           << (options.forVdbFile ? ", and the .vdb's OpenVDB leaves" : "")
+           << "), over the memory budget of " << formatGiB(budget)
            << " GiB; use a larger voxel size (this groom's default is " << defaultH << ")";
         throw InputError(os.str());
     }
@@ -931,7 +956,8 @@ std::ostream& operator<<(std::ostream& os, const SplatOptions& o) {
     return os << "SplatOptions(voxelSize=" << o.voxelSize << ", " << o.fiberScale
               << ", storeOrientationTensor=" << o.storeOrientationTensor
               << ", threaded=" << o.threaded << ", memoryBudgetBytes=" << o.memoryBudgetBytes
-              << ", sourceFile=\"" << o.sourceFile << "\", showProgress=" << o.showProgress << ")";
+              << ", forVdbFile=" << o.forVdbFile << ", sourceFile=\"" << o.sourceFile
+              << "\", showProgress=" << o.showProgress << ")";
 }
 
 } // namespace hairvox

@@ -118,7 +118,9 @@ SceneGroom loadGroom(const Scene& scene);
 struct SceneAssets {
     SceneGroom groom;
     SceneSurfaces surfaces;
-    std::optional<FiberGrid> grid; ///< present in the grid and approx modes
+    /// Present in the grid and approx modes; shared with the next frame's
+    /// assets when it reuses the grid (FrameReuse).
+    std::shared_ptr<const FiberGrid> grid;
     std::vector<DualScatteringTables> tables;    ///< per fiber type (groom.palette)
     std::unique_ptr<GlobalTermModel> globalTerm; ///< refers to `grid`: keep the assets together
     StageTimes times;                            ///< load, voxelize, tables

@@ -1,5 +1,6 @@
-// hairvox voxelize: the fiber grid — strands splatted into sparse OpenVDB grids
-// of fiber length density and orientation, and its .vdb file form.
+// hairvox voxelize: the fiber grid — strands splatted into a sparse grid of
+// fiber length density and orientation (8³ blocks, values packed), and its
+// .vdb file form (OpenVDB grids).
 //
 // The grid holds, per voxel, what the dual-scattering global term integrates
 // along a shadow ray (DESIGN.md §5; Zinke et al. 2008, Sadeghi & Tamstorf 2010
@@ -69,7 +70,7 @@
 //   list their active voxels by a 512-bit mask, and one packed array per
 //   quantity with a value per active voxel. A strand that the voxels resolve
 //   activates ~33 of a leaf's 512 voxels (Ratboy at 0.5 mm), so OpenVDB's
-//   leaves held 260 bytes per active voxel where the packed form holds 16
+//   leaves held 264 bytes per active voxel where the packed form holds 16
 //   (λ and E[u]) plus its block's 80: the splat's memory, and the kernel's
 //   zeroing of fresh pages that was most of its time, grow with the active
 //   voxels instead of with the leaves. toVdbGrids() builds the OpenVDB grids
@@ -200,6 +201,9 @@ struct SplatOptions {
     /// splatStrands refuses, before allocating, a voxel size whose estimated
     /// memory exceeds this.
     std::uint64_t memoryBudgetBytes = 4ull << 30;
+    /// The caller will write the grid as a .vdb (toVdbGrids): the estimate
+    /// also counts the file's OpenVDB leaves (vdbBlockBytes() a block).
+    bool forVdbFile = false;
     std::string sourceFile;    ///< recorded in FiberGridInfo
     bool showProgress = false; ///< progress bar on stderr
 };
@@ -230,7 +234,11 @@ struct FiberVdbGrids {
 /// same grids for any thread count).
 FiberVdbGrids toVdbGrids(const FiberGrid& grid);
 
-/// Bytes toVdbGrids(grid) allocates: its leaves, dense 8³ each.
+/// Bytes toVdbGrids() allocates for one block: a dense 8³ OpenVDB leaf in
+/// each grid (λ and E[u], the tensor's two, `typeFractions` fractions).
+std::uint64_t vdbBlockBytes(bool tensor, std::size_t typeFractions);
+
+/// Bytes toVdbGrids(grid) allocates: vdbBlockBytes() for each block.
 std::uint64_t vdbMemoryBytes(const FiberGrid& grid);
 
 /// Writes toVdbGrids(grid) as one .vdb file, atomically.
