@@ -29,8 +29,7 @@ std::size_t FiberGrid::find(const openvdb::Coord& ijk) const {
         [](const FiberBlock& block, const openvdb::Coord& o) { return block.origin < o; });
     if (it == blocks.end() || it->origin != origin)
         return kInactive;
-    const openvdb::Coord local = ijk - origin;
-    const auto offset = openvdb::Index((local.x() << 6) | (local.y() << 3) | local.z());
+    const openvdb::Index offset = FiberBlock::Leaf::coordToOffset(ijk);
     if (!it->active.isOn(offset))
         return kInactive;
     // The rank of the offset among the block's active voxels: the bits set

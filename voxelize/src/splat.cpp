@@ -446,7 +446,7 @@ public:
             const int leaf = leafBit(x / kLeafDim, y / kLeafDim, z / kLeafDim);
             touchedLeaves_ |= std::uint64_t(1) << leaf;
             leafVoxels_[std::size_t(leaf)].setOn(
-                openvdb::Index((x % kLeafDim) << 6 | (y % kLeafDim) << 3 | (z % kLeafDim)));
+                FiberBlock::Leaf::coordToOffset(openvdb::Coord(x, y, z)));
         });
         forEachTouchedLeaf([&](const Vec3i& lo) {
             auto& voxels = leafVoxels_[std::size_t(
@@ -463,9 +463,12 @@ public:
     }
 
 private:
-    static std::size_t index(int x, int y, int z) {
-        return ((std::size_t(x) * kAccDim + std::size_t(y)) * kAccDim + std::size_t(z)) * C;
+    /// Voxel (x, y, z)'s place among the accumulator's kVoxels, z fastest.
+    static std::size_t voxelIndex(int x, int y, int z) {
+        return (std::size_t(x) * kAccDim + std::size_t(y)) * kAccDim + std::size_t(z);
     }
+    /// Its first channel in sums_.
+    static std::size_t index(int x, int y, int z) { return voxelIndex(x, y, z) * C; }
 
     /// Adds ∫ w_v ds · channel, exactly, to the 8 corners of `cell` for a
     /// piece of length `pieceLength` whose fractions in the cell go from f to
@@ -484,7 +487,7 @@ private:
         // (Q0, Q1) of the (Y, Z) pairs (0,0), (0,1), (1,0), (1,1).
         const double q0[4] = {1 - y0 - z0 + pq0, z0 - pq0, y0 - pq0, pq0};
         const double q1[4] = {0.5 - y1 - z1 + pq1, z1 - pq1, y1 - pq1, pq1};
-        const std::size_t cellIndex = index(cell.x, cell.y, cell.z) / C;
+        const std::size_t cellIndex = voxelIndex(cell.x, cell.y, cell.z);
         touchedCells_[cellIndex >> 6] |= std::uint64_t(1) << (cellIndex & 63);
         double* base = &sums_[cellIndex * C];
         constexpr std::size_t dz = C, dy = std::size_t(kAccDim) * C, dx = dy * kAccDim;
@@ -521,8 +524,8 @@ private:
         FiberBlock block{origin, static_cast<std::uint32_t>(out.density.size()), {}};
         for (auto it = touched.beginOn(); it; ++it) {
             const openvdb::Index offset = it.pos();
-            const double* v = &sums_[index(lo.x + int(offset >> 6), lo.y + int(offset >> 3 & 7),
-                                           lo.z + int(offset & 7))];
+            const openvdb::Coord l = FiberBlock::Leaf::offsetToLocalCoord(offset);
+            const double* v = &sums_[index(lo.x + l.x(), lo.y + l.y(), lo.z + l.z())];
             const auto lambda = static_cast<float>(v[0] * invVoxelVolume);
             // Below FLT_MIN λ is physically nothing, and the ratios
             // below would lose their precision in denormals.
@@ -578,7 +581,7 @@ private:
     /// The brick's own touched voxels by leaf (leafBit()), found by extract.
     std::array<openvdb::util::NodeMask<3>, 64> leafVoxels_{};
     std::size_t fiberTypes_;
-    std::uint64_t touchedLeaves_ = 0; ///< leaves marked since the last extract, by leafBit()
+    std::uint64_t touchedLeaves_ = 0; ///< leaves with touched own voxels (extract), by leafBit()
 };
 
 template <bool Tensor, bool Typed>

@@ -120,10 +120,12 @@ struct FiberBlock {
     std::uint32_t first = 0;           ///< index of its first active voxel in the value arrays
     openvdb::util::NodeMask<3> active; ///< its active voxels by leaf offset, x·64 + y·8 + z
 
-    static constexpr int kDim = 8;
+    /// OpenVDB's leaf, whose offsets (coordToOffset, offsetToLocalCoord) `active` uses.
+    using Leaf = openvdb::FloatTree::LeafNodeType;
+    static constexpr int kDim = int(Leaf::DIM);
     /// Index-space coordinates of the voxel at leaf offset `offset`.
     openvdb::Coord voxel(openvdb::Index offset) const {
-        return origin + openvdb::Coord(int(offset >> 6), int(offset >> 3 & 7), int(offset & 7));
+        return origin + Leaf::offsetToLocalCoord(offset);
     }
 };
 
