@@ -28,6 +28,12 @@ std::map<std::string, openvdb::GridBase::Ptr> readAll(const fs::path& path) {
     return grids;
 }
 
+/// `hairvox voxelize` of Ratboy's groom to `vdb`, with `options`.
+auto voxelizeRatboy(const fs::path& vdb, const std::string& options) {
+    return test::runHairvox("voxelize " + quoted(test::dataDir() / "Ratboy_mohawk.tfx") + " " +
+                            options + " -o " + quoted(vdb));
+}
+
 std::string stringMeta(const openvdb::GridBase& g, const char* name) {
     const auto m = g.getMetadata<openvdb::StringMetadata>(name);
     return m ? m->value() : std::string("<missing>");
@@ -81,8 +87,7 @@ TEST(VdbMetadata, LitGridIsSelfDescribing) {
 TEST(VdbMetadata, FiberGridIsSelfDescribing) {
     test::TempDir dir;
     const fs::path vdb = dir / "fibers.vdb";
-    const auto r = test::runHairvox("voxelize " + quoted(test::dataDir() / "Ratboy_mohawk.tfx") +
-                                    " --voxel-size 0.01 --orientation-tensor -o " + quoted(vdb));
+    const auto r = voxelizeRatboy(vdb, "--voxel-size 0.01 --orientation-tensor");
     ASSERT_EQ(r.exitCode, 0) << r.output;
     const auto grids = readAll(vdb);
     ASSERT_TRUE(grids.count("density") && grids.count("orientation"));
@@ -111,8 +116,7 @@ TEST(VdbMetadata, VoxelizeRefusesAFileItsBudgetCannotBuild) {
     // splat, by its estimate of them, and no file is left.
     test::TempDir dir;
     const fs::path vdb = dir / "fibers.vdb";
-    const auto r = test::runHairvox("voxelize " + quoted(test::dataDir() / "Ratboy_mohawk.tfx") +
-                                    " --voxel-size 0.001 --memory-budget 0.1 -o " + quoted(vdb));
+    const auto r = voxelizeRatboy(vdb, "--voxel-size 0.001 --memory-budget 0.1");
     EXPECT_EQ(r.exitCode, 2) << r.output;
     EXPECT_NE(r.output.find("OpenVDB leaves"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("budget"), std::string::npos) << r.output;
