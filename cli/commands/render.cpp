@@ -1,7 +1,7 @@
 // hairvox render [SCENE.json ...] [--exr OUT.exr] [--png OUT.png] [-o OUT.exr|OUT.png]
-//                [--integrator dual_scattering|path] [--mode exact|grid|approx]
+//                [--integrator dual_scattering|path|volumetric] [--mode exact|grid|approx]
 //                [--shading-rate fragment|vertex] [--exr-compression rle|zips|zip|none]
-//                [--spp N]
+//                [--spp N] [--paths N]
 //                [--time-limit S] [--seed S] [--continue] [--width W] [--height H]
 //                [--voxel-size V] [--max-memory GIB] [--threads N] [--quiet]
 // Renders a scene (or the embedded default scene) to EXR + PNG and prints the
@@ -46,6 +46,7 @@ struct RenderCommandOptions {
     std::string output, exr, png;
     std::string mode, integrator, shadingRate, exrCompression, layers;
     std::optional<std::uint32_t> spp;
+    std::optional<std::uint64_t> paths;
     std::optional<double> timeLimit;
     std::optional<std::uint64_t> seed;
     bool continueRun = false;
@@ -180,16 +181,23 @@ Scene prepareScene(const RenderCommandOptions& opt, const std::string& path) {
             begin = end + 1;
         }
     }
-    if ((opt.spp || opt.timeLimit || opt.seed || opt.continueRun) &&
-        scene.integrator != Integrator::Path)
-        throw InputError("--spp, --time-limit, --seed and --continue apply to the path integrator "
+    if ((opt.spp || opt.timeLimit || opt.continueRun) && scene.integrator != Integrator::Path)
+        throw InputError("--spp, --time-limit and --continue apply to the path integrator "
                          "(--integrator path)");
+    if (opt.paths && scene.integrator != Integrator::Volumetric)
+        throw InputError("--paths applies to the volumetric integrator (--integrator volumetric)");
+    if (opt.seed && scene.integrator == Integrator::DualScattering)
+        throw InputError("--seed applies to the path and volumetric integrators (--integrator "
+                         "path|volumetric)");
     if (opt.spp)
         scene.pathTrace.spp = *opt.spp;
     if (opt.timeLimit)
         scene.pathTrace.timeLimit = *opt.timeLimit;
     if (opt.seed)
-        scene.pathTrace.seed = *opt.seed;
+        (scene.integrator == Integrator::Path ? scene.pathTrace.seed : scene.volumetric.seed) =
+            *opt.seed;
+    if (opt.paths)
+        scene.volumetric.paths = *opt.paths;
     resolveResolution(opt, scene.camera);
     if (opt.voxelSize)
         scene.voxelSize = *opt.voxelSize;
@@ -345,7 +353,8 @@ void addRenderCommand(CLI::App& app) {
     cmd->add_option("-o,--output", opt->output,
                     "Output file whose extension (.exr or .png) says which output it is");
     cmd->add_option("--integrator", opt->integrator,
-                    "dual_scattering (default) or path (the unbiased reference)")
+                    "dual_scattering (default), volumetric (multiple scattering solved on the "
+                    "fiber grid) or path (the unbiased reference)")
         ->check(CLI::IsMember(kIntegratorNames.names()));
     cmd->add_option("--mode", opt->mode, "Global-term mode (dual scattering)")
         ->check(CLI::IsMember(kGlobalTermModeNames.names()));
@@ -376,7 +385,12 @@ void addRenderCommand(CLI::App& app) {
     cmd->add_option("--spp", opt->spp, "Path tracing: samples per pixel [1, 1000000]");
     cmd->add_option("--time-limit", opt->timeLimit,
                     "Path tracing: stop after this many seconds (whole passes) [0, 1e7]");
-    cmd->add_option("--seed", opt->seed, "Path tracing: random seed");
+    cmd->add_option("--seed", opt->seed, "Path tracing and volumetric: random seed");
+    cmd->add_option("--paths", opt->paths,
+                    strCat("Volumetric: light paths traced through the fiber grid (default: "
+                           "the scene's, or ", VolumetricSettings{}.pathsPerCell,
+                           " per cache cell) [1, 2^40]"))
+        ->check(CLI::Range(std::uint64_t(1), std::uint64_t(1) << 40));
     cmd->add_flag("--continue", opt->continueRun,
                   "Path tracing: add samples to the output EXR of an earlier run of this scene");
     cmd->add_option("--width", opt->width,

@@ -16,10 +16,16 @@ std::int64_t nanosSince(std::chrono::steady_clock::time_point start) {
         .count();
 }
 
-/// Radiance layers: the ShadeResult components in order.
-constexpr std::size_t kRadianceLayers = 5;
-/// Floats per light among the averages: V, n, T_s (3), σ_f (3).
-constexpr std::size_t kLightFloats = 8;
+/// Radiance layers: dual scattering's ShadeResult components in order, or
+/// the three single-scattering lobes and the volumetric multiple scattering.
+std::size_t radianceLayers(bool multipleScattering) {
+    return multipleScattering ? 4 : 5;
+}
+/// Floats per light among the averages: V, n, and for dual scattering T_s
+/// (3), σ_f (3).
+std::size_t lightFloats(bool multipleScattering) {
+    return multipleScattering ? 2 : 8;
+}
 
 void put(float* out, const Rgb& c) {
     out[0] = c.r;
@@ -31,22 +37,30 @@ void put(float* out, const Rgb& c) {
 
 DualScatteringFragmentShader::DualScatteringFragmentShader(
     std::vector<DualScatteringShader> shaders, std::span<const std::uint8_t> fiberType,
-    std::vector<Light> lights, std::vector<std::shared_ptr<const LightGlobalTerm>> lightTerms)
+    std::vector<Light> lights, std::vector<std::shared_ptr<const LightGlobalTerm>> lightTerms,
+    const RadianceCache* multiple)
     : shaders_(std::move(shaders))
     , fiberType_(fiberType)
     , lights_(std::move(lights))
     , terms_(std::move(lightTerms))
-    , layout_(dualScatteringLayout(lights_))
+    , multiple_(multiple)
+    , layout_(hairShaderLayout(lights_, multiple != nullptr))
     , stats_(lights_.size()) {}
 
-ShaderLayout dualScatteringLayout(std::span<const Light> lights) {
+ShaderLayout hairShaderLayout(std::span<const Light> lights, bool multipleScattering) {
     ShaderLayout layout;
-    layout.radiance = {"direct_R", "direct_TT", "direct_TRT", "back_direct", "scatter"};
+    layout.radiance = {"direct_R", "direct_TT", "direct_TRT"};
+    if (multipleScattering)
+        layout.radiance.emplace_back("multiple");
+    else
+        layout.radiance.insert(layout.radiance.end(), {"back_direct", "scatter"});
     for (const Light& light : lights) {
         layout.averages.push_back({light.name + ".V", 1});
         layout.averages.push_back({light.name + ".n", 1});
-        layout.averages.push_back({light.name + ".T_s", 3});
-        layout.averages.push_back({light.name + ".sigma_f", 3});
+        if (!multipleScattering) {
+            layout.averages.push_back({light.name + ".T_s", 3});
+            layout.averages.push_back({light.name + ".sigma_f", 3});
+        }
     }
     return layout;
 }
@@ -56,6 +70,9 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
     const auto start = std::chrono::steady_clock::now();
     const std::size_t lightCount = lights_.size();
     const std::size_t stride = layout_.stride();
+    const bool volumetric = multiple_ != nullptr;
+    const std::size_t radianceFloats = 3 * radianceLayers(volumetric);
+    const std::size_t perLight = lightFloats(volumetric);
     std::fill(out.begin(), out.end(), 0.0f);
     // This thread's arrays from the batches before (every element written
     // before it is read).
@@ -117,11 +134,13 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
         }
         for (std::size_t i = 0; i < points.size(); ++i) {
             const GlobalTerm& g = terms[i];
-            float* lightOut = out.data() + i * stride + 3 * kRadianceLayers + l * kLightFloats;
+            float* lightOut = out.data() + i * stride + radianceFloats + l * perLight;
             lightOut[0] = g.V;
             lightOut[1] = g.n;
-            put(lightOut + 2, g.T_s);
-            put(lightOut + 5, safeSqrt(g.sigma2_f));
+            if (!volumetric) {
+                put(lightOut + 2, g.T_s);
+                put(lightOut + 5, safeSqrt(g.sigma2_f));
+            }
         }
         if (!terms_[l])
             continue; // a skipped light contributes nothing
@@ -137,8 +156,12 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
                     batch.setIncident(k, path.omega, light.irradiance(path.distance));
                 }
             }
-            for (std::size_t k = 0; k < batch.size(); ++k)
-                batch.setGlobalTerm(k, terms[pointOf(t, k)]);
+            for (std::size_t k = 0; k < batch.size(); ++k) {
+                GlobalTerm g = terms[pointOf(t, k)];
+                if (volumetric)
+                    g.T_s = Rgb(0.0f); // the forward-scattered light is the cache's
+                batch.setGlobalTerm(k, g);
+            }
             shaders_[t].shade(batch);
         }
     }
@@ -150,8 +173,13 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
             put(o, r.directR);
             put(o + 3, r.directTT);
             put(o + 6, r.directTRT);
-            put(o + 9, r.backDirect);
-            put(o + 12, r.scatter);
+            if (volumetric) {
+                const ShadingPoint& p = points[pointOf(t, k)];
+                put(o + 9, multiple_->outgoing(p.position, p.tangent, p.toCamera, t));
+            } else {
+                put(o + 9, r.backDirect);
+                put(o + 12, r.scatter);
+            }
         }
     }
     globalTermNanos_ += globalTermNanos;

@@ -1,13 +1,22 @@
-// hairvox pipeline (private): the FragmentShader of a dual-scattering render —
-// the dual-scattering shader (shading/) fed with each light's global term
-// (transmittance/), weighted by each light's irradiance.
+// hairvox pipeline (private): the FragmentShader of the rasterized integrators
+// — the dual-scattering shader (shading/) fed with each light's global term
+// (transmittance/), weighted by each light's irradiance; for the volumetric
+// integrator, its single scattering with the multiple scattering read from
+// the radiance cache (volumetric/radiance_cache.h) instead of dual
+// scattering's.
 //
 // Layout (render/fragment_shader.h), the EXR layers of a render:
 //   radiance  direct_R, direct_TT, direct_TRT   V·f_p·cos θ_i per lobe (single scattering)
+//   dual scattering:
 //             back_direct                      V·d_b·f_back^direct·cos θ_i (local multiple
-//             scattering) scatter                          F_scatter·cos θ_i (global multiple
-//             scattering)
-//   averages  per light l: l.V, l.n (scalars), l.T_s, l.sigma_f (RGB, σ_f = √σ_f²)
+//                                              scattering)
+//             scatter                          F_scatter·cos θ_i (global multiple scattering)
+//   volumetric:
+//             multiple                         ∫ f_s L cos θ_i dω_i over the cached light that
+//                                              has scattered at least once (the path
+//                                              tracer's layer of the same name)
+//   averages  per light l: l.V, l.n (scalars); dual scattering also l.T_s, l.sigma_f
+//             (RGB, σ_f = √σ_f²)
 // A point is shaded with the shader of its segment's fiber type (Groom::fiberType).
 #pragma once
 
@@ -15,6 +24,7 @@
 #include <hairvox/render/fragment_shader.h>
 #include <hairvox/shading/dual_scattering_shader.h>
 #include <hairvox/transmittance/global_term_model.h>
+#include <hairvox/volumetric/radiance_cache.h>
 
 #include <atomic>
 #include <memory>
@@ -24,8 +34,9 @@
 
 namespace hairvox::detail {
 
-/// The layout above for these lights.
-ShaderLayout dualScatteringLayout(std::span<const Light> lights);
+/// The layout above for these lights: dual scattering's, or with
+/// `multipleScattering` the volumetric integrator's.
+ShaderLayout hairShaderLayout(std::span<const Light> lights, bool multipleScattering);
 
 class DualScatteringFragmentShader final : public FragmentShader {
 public:
@@ -33,9 +44,13 @@ public:
     /// (Groom::fiberType, empty for an untyped groom; it must outlive the
     /// shader). `lightTerms[l]` is the global term toward lights[l], or null
     /// for a light that is skipped (contributes nothing; its AOVs read "blocked").
+    /// `multiple` (the volumetric integrator; must outlive the shader): the
+    /// multiple scattering comes from it, and the shaders give single
+    /// scattering only (their back_direct and scatter are not read).
     DualScatteringFragmentShader(std::vector<DualScatteringShader> shaders,
                                  std::span<const std::uint8_t> fiberType, std::vector<Light> lights,
-                                 std::vector<std::shared_ptr<const LightGlobalTerm>> lightTerms);
+                                 std::vector<std::shared_ptr<const LightGlobalTerm>> lightTerms,
+                                 const RadianceCache* multiple = nullptr);
 
     const ShaderLayout& layout() const override { return layout_; }
     void shade(std::span<const ShadingPoint> points, std::span<float> out) const override;
@@ -51,6 +66,7 @@ private:
     std::span<const std::uint8_t> fiberType_;
     std::vector<Light> lights_;
     std::vector<std::shared_ptr<const LightGlobalTerm>> terms_;
+    const RadianceCache* multiple_;
     ShaderLayout layout_;
     mutable std::atomic<std::int64_t> globalTermNanos_{0}, shadeNanos_{0};
     mutable std::mutex statsMutex_;

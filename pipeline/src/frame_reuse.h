@@ -20,10 +20,15 @@ struct FrameReuse::State {
     std::uint64_t gridKey = 0, modelKey = 0;
     /// Its lights' prepared terms (of assets->globalTerm), by lightKey().
     std::map<std::uint64_t, std::shared_ptr<const LightGlobalTerm>> lights;
+    /// The volumetric integrator's solution, and the key it was solved under
+    /// (the model's key, every light's, the integrator's settings).
+    std::shared_ptr<const MultipleScatteringSolution> multiple;
+    std::uint64_t multipleKey = 0;
 
     /// Forgets the frame before (its memory is freed unless this frame shares it).
     void release() {
         lights.clear();
+        multiple.reset();
         assets.reset();
     }
 };

@@ -309,7 +309,7 @@ FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, Sc
     throwIfInterrupted();
 
     const std::uint64_t groom = reuse ? detail::groomKey(assets->groom.groom) : 0;
-    if (scene.globalTermMode != GlobalTermMode::Exact) {
+    if (scene.globalTermMode != GlobalTermMode::Exact || scene.integrator == Integrator::Volumetric) {
         checkVoxelSizeForGroom(scene, assets->groom.groom);
         const SplatOptions splat = splatOptions(scene, options);
         if (reuse)
@@ -389,8 +389,44 @@ std::unique_ptr<SceneAssets> loadSceneAssets(const Scene& scene, const PipelineO
 
 namespace {
 
-SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& options,
-                                 bool writeFiles, FrameReuse::State* reuse) {
+/// The volumetric integrator's multiple scattering: solved on the fiber grid
+/// (volumetric/), or the frame before's where everything it is made of is
+/// unchanged (`key`).
+std::shared_ptr<const MultipleScatteringSolution>
+solveMultiple(const Scene& scene, const PipelineOptions& options, const SceneAssets& assets,
+              FrameReuse::State* reuse, std::uint64_t key, bool& reused) {
+    reused = false;
+    if (reuse && reuse->multiple && reuse->multipleKey == key) {
+        reused = true;
+        return reuse->multiple;
+    }
+    if (reuse)
+        reuse->multiple.reset(); // before allocating this frame's
+    VolumetricScene vs;
+    vs.grid = assets.grid.get();
+    vs.groom = &assets.groom.groom;
+    vs.fibers = assets.groom.palette.fibers;
+    vs.lights = scene.lights;
+    vs.surfaces = assets.surfaces.scene;
+    vs.surfaceAlbedo = assets.surfaces.albedo;
+    VolumetricSettings settings = scene.volumetric;
+    settings.threads = options.threads;
+    settings.progress = options.progress;
+    // What the limit leaves once the film, the groom and the grid are counted.
+    const std::uint64_t used = estimateRenderMemory(scene).total() + assets.grid->memoryBytes();
+    const std::uint64_t budget =
+        options.maxMemoryBytes > used ? options.maxMemoryBytes - used : std::uint64_t(1);
+    auto solution = std::make_shared<const MultipleScatteringSolution>(
+        solveMultipleScattering(vs, settings, budget));
+    if (reuse) {
+        reuse->multiple = solution;
+        reuse->multipleKey = key;
+    }
+    return solution;
+}
+
+SceneRender renderRasterized(const Scene& scene, const PipelineOptions& options, bool writeFiles,
+                             FrameReuse::State* reuse) {
     SceneRender result;
     auto built = std::make_shared<SceneAssets>();
     const FrameAssets frame = prepareAssets(scene, options, built.get(), reuse);
@@ -471,6 +507,22 @@ SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& opti
                 reuse->lights.emplace(lightKeys[l], terms[l]);
     }
 
+    // The volumetric integrator's multiple scattering, solved once the
+    // lights' global terms are prepared (and their workspace freed).
+    std::shared_ptr<const MultipleScatteringSolution> multiple;
+    if (scene.integrator == Integrator::Volumetric) {
+        const auto start = Clock::now();
+        Hasher key;
+        key.value(frame.modelKey);
+        for (const Light& light : scene.lights)
+            key.value(detail::lightKey(frame.modelKey, light));
+        scene.volumetric.hashInto(key);
+        multiple = solveMultiple(scene, options, *assets, reuse, key.digest(), result.multipleReused);
+        result.volumetric = multiple->stats;
+        result.times.multiple = secondsSince(start);
+    }
+    const RadianceCache* cache = multiple ? multiple->cache.get() : nullptr;
+
     // The surfaces as the camera sees them, lit through the hair.
     const Camera camera(scene.camera);
     const auto surfacesStart = Clock::now();
@@ -480,18 +532,24 @@ SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& opti
         for (const auto& t : terms)
             lightTerms.push_back(t.get());
         surfaces = detail::surfaceLayer(*assets->surfaces.scene, assets->surfaces.albedo, camera,
-                                        scene.lights, lightTerms);
+                                        scene.lights, lightTerms,
+                                        multiple ? multiple->surfaces.get() : nullptr);
     }
     const double surfaceSeconds = secondsSince(surfacesStart);
 
     // One shader per fiber type (the shaders refer to their bcsdf and tables).
+    // The volumetric integrator reads their single scattering only: with
+    // d_b = 0 and T_s = 0 they spend nothing on dual scattering's terms.
     const SceneGroom& groom = assets->groom;
     std::vector<MarschnerBcsdf> bcsdfs(groom.palette.fibers.begin(), groom.palette.fibers.end());
+    DualScatteringParams shaderParams = scene.dualScattering;
+    if (cache)
+        shaderParams.d_b = 0;
     std::vector<DualScatteringShader> shaders;
     for (std::size_t t = 0; t < bcsdfs.size(); ++t)
-        shaders.emplace_back(bcsdfs[t], assets->tables[t], scene.dualScattering);
+        shaders.emplace_back(bcsdfs[t], assets->tables[t], shaderParams);
     const detail::DualScatteringFragmentShader fragmentShader(
-        std::move(shaders), groom.groom.fiberType, scene.lights, std::move(terms));
+        std::move(shaders), groom.groom.fiberType, scene.lights, std::move(terms), cache);
     RasterOutput image = rasterize(groom.groom, camera, fragmentShader,
                                    rasterSettings(scene, options), surfaces);
     result.film = std::move(image.film);
@@ -629,8 +687,8 @@ SceneRender renderScene(const Scene& scene, const PipelineOptions& options, bool
     const ThreadLimit threadLimit(options.threads);
     return scene.integrator == Integrator::Path
                ? renderPathTraced(scene, withLimit, writeFiles)
-               : renderDualScattering(scene, withLimit, writeFiles,
-                                      reuse ? reuse->state_.get() : nullptr);
+               : renderRasterized(scene, withLimit, writeFiles,
+                                  reuse ? reuse->state_.get() : nullptr);
 }
 
 std::vector<std::string> hairRadianceLayers(const Film& film) {
@@ -641,7 +699,7 @@ std::vector<std::string> hairRadianceLayers(const Film& film) {
         layers.emplace_back("back_direct");
         layers.emplace_back("scatter");
     } else {
-        throw std::out_of_range("the image has neither the path tracer's layer 'multiple' nor the "
+        throw std::out_of_range("the image has neither layer 'multiple' (path tracer, volumetric) nor the "
                                 "dual-scattering layers 'back_direct' and 'scatter'");
     }
     return layers;
@@ -696,7 +754,7 @@ void writeExrOutput(const Film& film, const Scene& scene,
         header.worldToCamera = Camera(scene.camera).worldToCameraMatrix();
         header.attributes = {{"hairvox:scene", scene.name},
                              {"hairvox:integrator", toString(scene.integrator)}};
-        if (scene.integrator == Integrator::DualScattering) {
+        if (isRasterized(scene.integrator)) {
             header.attributes["hairvox:globalTermMode"] = toString(scene.globalTermMode);
             header.attributes["hairvox:voxelSize"] =
                 scene.voxelSize ? strCat(*scene.voxelSize) : "auto";
@@ -753,9 +811,10 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
         std::snprintf(line, sizeof(line), "hairvox: %s, path traced, %dx%d: %.2f s\n",
                       scene.name.c_str(), camera.width(), camera.height(), r.times.total());
     else
-        std::snprintf(line, sizeof(line), "hairvox: %s, %s mode, %dx%d: %.2f s\n",
-                      scene.name.c_str(), toString(scene.globalTermMode), camera.width(),
-                      camera.height(), r.times.total());
+        std::snprintf(line, sizeof(line), "hairvox: %s, %s%s mode, %dx%d: %.2f s\n",
+                      scene.name.c_str(), r.volumetric ? "volumetric, " : "",
+                      toString(scene.globalTermMode), camera.width(), camera.height(),
+                      r.times.total());
     os << line;
     const auto row = [&](const char* stage, double seconds, const std::string& detail) {
         std::snprintf(line, sizeof(line), "  %-12s %7.3f s  %s\n", stage, seconds, detail.c_str());
@@ -840,6 +899,32 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
         std::snprintf(line, sizeof(line), "%.3f s preparing the lights (one after another: ",
                       r.globalTermPrepareSeconds);
         more(line + prepared + "); the rest: lookups while shading");
+    }
+    if (r.volumetric) {
+        const VolumetricStats& v = *r.volumetric;
+        if (r.multipleReused) {
+            row("multiple", r.times.multiple,
+                "the frame before's solution (the same grid, lights, surfaces and settings)");
+        } else {
+            std::snprintf(line, sizeof(line),
+                          "%s light paths through the fiber grid: %s fiber and %s surface "
+                          "scatterings, deepest %u, %s stopped at the depth cap",
+                          thousands(v.paths).c_str(), thousands(v.fiberEvents).c_str(),
+                          thousands(v.surfaceEvents).c_str(), v.deepestPath,
+                          thousands(v.pathsAtDepthCap).c_str());
+            row("multiple", r.times.multiple, line);
+            std::snprintf(line, sizeof(line),
+                          "%s cells of %.3g (%d x %d coefficients per channel), %s deposits; "
+                          "%llu MB held; trace %.3f s, scattering tables %.3f s",
+                          thousands(v.cells).c_str(),
+                          double(scene.volumetric.cache.cellVoxels) * r.voxelSize,
+                          scene.volumetric.cache.basis.thetaBins,
+                          scene.volumetric.cache.basis.coefficientsPerBin(),
+                          thousands(v.crossings).c_str(),
+                          static_cast<unsigned long long>(megabytes(v.bytes)), v.traceSeconds,
+                          v.finishSeconds);
+            more(line);
+        }
     }
     row("raster", r.times.raster,
         thousands(st.fragments) + " fragments; skipped: " + thousands(st.segmentsOutsideView) +

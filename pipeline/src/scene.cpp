@@ -37,6 +37,7 @@ constexpr Range kShadingTolerance{0.0, 1.0};
 constexpr Range kTailTransmittance{0.0, 1.0};
 constexpr Range kExposure{-20.0, 20.0};
 constexpr Range kTimeLimit{0.0, 1e7};
+constexpr Range kPathsPerCell{0.0, 1e4, true};
 constexpr Range kDegrees{-360.0, 360.0};
 constexpr Range kAny{-1e30, 1e30};
 constexpr Range kMeshScale{-1e6, 1e6};
@@ -437,6 +438,7 @@ void Scene::validate() const {
     requireInRange("tail_transmittance", tailTransmittance, kTailTransmittance);
     try {
         pathTrace.validate();
+        volumetric.validate();
     } catch (const InputError& e) {
         throw InputError(strCat("integrator: ", e.what()));
     }
@@ -473,7 +475,8 @@ void Scene::validate() const {
 }
 
 std::vector<RasterLayer> layersOf(const Scene& scene) {
-    return rasterLayers(detail::dualScatteringLayout(scene.lights));
+    return rasterLayers(
+        detail::hairShaderLayout(scene.lights, scene.integrator == Integrator::Volumetric));
 }
 
 Scene parseScene(const nlohmann::json& document, const std::string& sourceName,
@@ -536,29 +539,67 @@ Scene parseScene(const nlohmann::json& document, const std::string& sourceName,
         } else {
             JsonObject in = v.object();
             scene.integrator =
-                in.required("type", "\"dual_scattering\" or \"path\"").oneOf(kIntegratorNames);
+                in.required("type", "\"dual_scattering\", \"path\" or \"volumetric\"")
+                    .oneOf(kIntegratorNames);
             PathTraceSettings& pt = scene.pathTrace;
-            const auto set = [&](std::string_view key, auto assign) {
+            VolumetricSettings& vol = scene.volumetric;
+            // A key applies to the integrators it names; each value is checked
+            // against its integrator's ranges as it is read.
+            using Owners = std::vector<Integrator>;
+            const auto set = [&](std::string_view key, const Owners& owners, auto assign) {
                 const JsonValue x = in[key];
                 if (!x.present())
                     return;
-                if (scene.integrator != Integrator::Path)
-                    x.fail("applies to the path integrator only (\"type\": \"path\")");
+                if (std::find(owners.begin(), owners.end(), scene.integrator) == owners.end()) {
+                    std::string names;
+                    for (const Integrator o : owners)
+                        names += strCat(names.empty() ? "" : " and ", "\"", toString(o), "\"");
+                    x.fail(strCat("applies to the ", names, " integrator",
+                                  owners.size() > 1 ? "s" : "", " only (\"type\")"));
+                }
                 assign(x);
-                checkAt(x, [&] { pt.validate(); });
+                checkAt(x, [&] {
+                    if (scene.integrator == Integrator::Path)
+                        pt.validate();
+                    else
+                        vol.validate();
+                });
             };
-            set("spp", [&](const JsonValue& x) {
+            const Owners path{Integrator::Path}, volumetric{Integrator::Volumetric};
+            const Owners traced{Integrator::Path, Integrator::Volumetric};
+            set("spp", path, [&](const JsonValue& x) {
                 pt.spp = static_cast<std::uint32_t>(x.integer(1, 1'000'000));
             });
-            set("time_limit", [&](const JsonValue& x) { pt.timeLimit = x.number(kTimeLimit); });
-            set("max_depth", [&](const JsonValue& x) {
-                pt.maxDepth = static_cast<std::uint32_t>(x.integer(1, 100'000));
+            set("time_limit", path, [&](const JsonValue& x) { pt.timeLimit = x.number(kTimeLimit); });
+            const auto depth = [&](const JsonValue& x) {
+                return static_cast<std::uint32_t>(x.integer(1, 100'000));
+            };
+            set("max_depth", traced, [&](const JsonValue& x) {
+                (scene.integrator == Integrator::Path ? pt.maxDepth : vol.maxDepth) = depth(x);
             });
-            set("roulette_depth", [&](const JsonValue& x) {
-                pt.rouletteDepth = static_cast<std::uint32_t>(x.integer(1, 100'000));
+            set("roulette_depth", traced, [&](const JsonValue& x) {
+                (scene.integrator == Integrator::Path ? pt.rouletteDepth : vol.rouletteDepth) =
+                    depth(x);
             });
-            set("seed", [&](const JsonValue& x) {
-                pt.seed = x.integer(0, std::numeric_limits<std::uint64_t>::max());
+            set("seed", traced, [&](const JsonValue& x) {
+                (scene.integrator == Integrator::Path ? pt.seed : vol.seed) =
+                    x.integer(0, std::numeric_limits<std::uint64_t>::max());
+            });
+            set("paths", volumetric,
+                [&](const JsonValue& x) { vol.paths = x.integer(1, 1ull << 40); });
+            set("paths_per_cell", volumetric,
+                [&](const JsonValue& x) { vol.pathsPerCell = x.numberF(kPathsPerCell); });
+            set("cell_voxels", volumetric, [&](const JsonValue& x) {
+                vol.cache.cellVoxels = static_cast<int>(x.integer(1, 16));
+            });
+            set("theta_bins", volumetric, [&](const JsonValue& x) {
+                vol.cache.basis.thetaBins = static_cast<int>(x.integer(2, 64));
+            });
+            set("transport", volumetric,
+                [&](const JsonValue& x) { vol.transport = x.oneOf(kVolumetricTransportNames); });
+            set("azimuthal_order", volumetric, [&](const JsonValue& x) {
+                vol.cache.basis.azimuthalOrder =
+                    static_cast<int>(x.integer(0, RadianceBasis::kMaxOrder));
             });
             in.finish();
         }

@@ -224,7 +224,8 @@ void coverRow(const ViewCorners& view, int y, SurfaceLayer& layer,
 /// evaluated kBatch samples at a time per light.
 void lightSamples(std::span<const ShadingSample> samples, const std::vector<Rgb>& albedo,
                   const std::vector<Light>& lights,
-                  const std::vector<const LightGlobalTerm*>& terms, std::vector<Rgb>& radiance) {
+                  const std::vector<const LightGlobalTerm*>& terms,
+                  const SurfaceIrradiance* scattered, std::vector<Rgb>& radiance) {
     struct Scratch {
         std::vector<GlobalTermQuery> queries;
         std::vector<std::size_t> which; ///< per query: its sample
@@ -263,18 +264,25 @@ void lightSamples(std::span<const ShadingSample> samples, const std::vector<Rgb>
             for (std::size_t k = 0; k < queries.size(); ++k) {
                 const std::size_t i = which[k];
                 const float distance = light.pathFrom(queries[k].position).distance;
+                const Rgb through = scattered ? Rgb(g[k].V) : Rgb(g[k].V) + g[k].T_s;
                 radiance[i] += float(InvPi) * albedo[samples[i].view.surface] *
-                               light.irradiance(distance) * cosines[k] * (Rgb(g[k].V) + g[k].T_s);
+                               light.irradiance(distance) * cosines[k] * through;
             }
         }
     }
+    if (scattered)
+        for (std::size_t i = 0; i < samples.size(); ++i) {
+            const ViewSample& v = samples[i].view;
+            radiance[i] += float(InvPi) * albedo[v.surface] * scattered->irradiance(v.position);
+        }
 }
 
 } // namespace
 
 SurfaceLayer surfaceLayer(const SurfaceScene& surfaces, const std::vector<Rgb>& albedo,
                           const Camera& camera, const std::vector<Light>& lights,
-                          const std::vector<const LightGlobalTerm*>& terms) {
+                          const std::vector<const LightGlobalTerm*>& terms,
+                          const SurfaceIrradiance* scattered) {
     const int width = camera.width(), height = camera.height();
     const std::size_t pixels = std::size_t(width) * std::size_t(height);
     SurfaceLayer layer;
@@ -329,7 +337,7 @@ SurfaceLayer surfaceLayer(const SurfaceScene& surfaces, const std::vector<Rgb>& 
                                       width, Rgb(0.0f));
             coverRow(view, y, layer, samples);
         }
-        lightSamples(samples, albedo, lights, terms, radiance);
+        lightSamples(samples, albedo, lights, terms, scattered, radiance);
         for (std::size_t i = 0; i < samples.size(); ++i)
             layer.radiance[samples[i].pixel] += samples[i].weight * radiance[i];
     });

@@ -17,7 +17,11 @@
 // with V and T_s the light's global term at the point (transmittance/: the
 // hair's shadow — unscattered and forward-scattered light — and the other
 // surfaces' shadow, withSurfaces()), queried a surfaceOffset() off the surface
-// as a point on no fiber.
+// as a point on no fiber. With the volumetric integrator the scattered light
+// is its solution's instead of dual scattering's T_s:
+//     L = (ρ/π) [Σ_l E_l · max(0, n·ω_l) · V_l + E_s(x)],
+// E_s the irradiance of the light the hair (and the surfaces) scattered onto
+// the surface (volumetric/surface_irradiance.h).
 #pragma once
 
 #include <hairvox/core/rgb.h>
@@ -26,15 +30,18 @@
 #include <hairvox/geometry/surface_scene.h>
 #include <hairvox/render/rasterizer.h>
 #include <hairvox/transmittance/global_term_model.h>
+#include <hairvox/volumetric/surface_irradiance.h>
 
 #include <vector>
 
 namespace hairvox::detail {
 
 /// `terms[l]` is light l's global term, or null for a light that is skipped;
-/// `albedo` has one entry per surface.
+/// `albedo` has one entry per surface; `scattered` the volumetric
+/// integrator's scattered light on the surfaces (null: dual scattering).
 SurfaceLayer surfaceLayer(const SurfaceScene& surfaces, const std::vector<Rgb>& albedo,
                           const Camera& camera, const std::vector<Light>& lights,
-                          const std::vector<const LightGlobalTerm*>& terms);
+                          const std::vector<const LightGlobalTerm*>& terms,
+                          const SurfaceIrradiance* scattered = nullptr);
 
 } // namespace hairvox::detail

@@ -1,4 +1,4 @@
-#include "gauss_legendre.h"
+#include <hairvox/core/gauss_legendre.h>
 #include "shade_kernel.h"
 
 #include <hairvox/core/atomic_file.h>

@@ -76,15 +76,18 @@ void checkVoxelSizeForGroom(const Scene& scene, const Groom& groom);
 
 /// Wall-clock seconds per stage.
 struct StageTimes {
-    double load = 0, voxelize = 0, tables = 0, globalTerm = 0, raster = 0, shade = 0;
+    double load = 0, voxelize = 0, tables = 0, globalTerm = 0;
+    double multiple = 0; ///< the volumetric integrator's solve (its lookups are in shade)
+    double raster = 0, shade = 0;
     double trace = 0; ///< path tracing
     double write = 0;
     double total() const {
-        return load + voxelize + tables + globalTerm + raster + shade + trace + write;
+        return load + voxelize + tables + globalTerm + multiple + raster + shade + trace + write;
     }
     StageTimes& operator+=(const StageTimes& o) {
         load += o.load, voxelize += o.voxelize, tables += o.tables, globalTerm += o.globalTerm;
-        raster += o.raster, shade += o.shade, trace += o.trace, write += o.write;
+        multiple += o.multiple, raster += o.raster, shade += o.shade, trace += o.trace;
+        write += o.write;
         return *this;
     }
 };
@@ -148,8 +151,10 @@ struct LightReport {
 
 struct SceneRender {
     Film film;
-    std::optional<RasterStats> raster;       ///< the dual-scattering integrator's
+    std::optional<RasterStats> raster;       ///< the rasterized integrators'
     std::optional<PathTraceStats> pathTrace; ///< the path tracer's
+    std::optional<VolumetricStats> volumetric; ///< the volumetric integrator's solve
+    bool multipleReused = false; ///< its solution taken from the frame before (FrameReuse)
     std::vector<std::string> warnings;       ///< for the user (rejected shader results, ...)
     StageTimes times;
     std::vector<LightReport> lights;
@@ -175,10 +180,12 @@ struct SceneRender {
 /// moving around a still groom under still lights (a turntable) splats and
 /// prepares once; a frame that moves one light prepares that light again; a
 /// new colour keeps the grid and prepares the lights; a groom file rewritten
-/// between frames is splatted again. Each frame is still loaded (its contents
-/// are the key), and reused or not it is the same bytes as rendered alone.
-/// Between frames it holds one frame's groom, grid and light terms. Only the
-/// dual-scattering integrator uses it.
+/// between frames is splatted again. The volumetric integrator's solution is
+/// kept when its grid, model, lights, surfaces and settings are unchanged
+/// (it does not depend on the camera). Each frame is still loaded (its
+/// contents are the key), and reused or not it is the same bytes as rendered
+/// alone. Between frames it holds one frame's groom, grid, light terms and
+/// solution. The path integrator does not use it.
 class FrameReuse {
 public:
     FrameReuse();

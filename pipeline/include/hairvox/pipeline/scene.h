@@ -27,6 +27,7 @@
 #include <hairvox/strands/fiber_scale.h>
 #include <hairvox/strands/procedural.h>
 #include <hairvox/transmittance/global_term_mode.h>
+#include <hairvox/volumetric/multiple_scattering.h>
 
 #include <nlohmann/json_fwd.hpp>
 
@@ -85,14 +86,22 @@ struct ExactSettings {
     std::uint64_t seed = 1;
 };
 
-/// How a scene is rendered: the dual-scattering rasterizer, or the path tracer
-/// of the same fibers (the ground truth; pathtrace/path_tracer.h).
-enum class Integrator { DualScattering, Path };
+/// How a scene is rendered: the dual-scattering rasterizer, the path tracer
+/// of the same fibers (the ground truth; pathtrace/path_tracer.h), or the
+/// rasterizer with multiple scattering solved on the fiber grid
+/// (volumetric/multiple_scattering.h).
+enum class Integrator { DualScattering, Path, Volumetric };
 
-inline constexpr EnumNames<Integrator, 2> kIntegratorNames{{{
+inline constexpr EnumNames<Integrator, 3> kIntegratorNames{{{
     {Integrator::DualScattering, "dual_scattering"},
     {Integrator::Path, "path"},
+    {Integrator::Volumetric, "volumetric"},
 }}};
+/// Whether the integrator draws the hair with the rasterizer (its fragment
+/// shading, shading rates, global term and layers).
+inline bool isRasterized(Integrator i) {
+    return i != Integrator::Path;
+}
 inline const char* toString(Integrator i) {
     return kIntegratorNames.name(i);
 }
@@ -127,6 +136,7 @@ struct Scene {
     std::optional<float> fiberSampleSpacing;
     Integrator integrator = Integrator::DualScattering;
     PathTraceSettings pathTrace; ///< the path integrator's spp, time limit, depth and seed
+    VolumetricSettings volumetric; ///< the volumetric integrator's paths, cache and seed
     GlobalTermMode globalTermMode = GlobalTermMode::Grid;
     ExactSettings exact;
     ShadingRate shadingRate = ShadingRate::Fragment;

@@ -1,4 +1,4 @@
-// hairvox shading (internal): Gauss–Legendre quadrature for the table integrals
+// hairvox core: Gauss–Legendre quadrature for the table integrals of shading/ and volumetric/
 // (Tungsten's precomputeAzimuthalDistributions uses the same rule over h).
 //
 // An n-point rule integrates polynomials of degree 2n − 1 exactly; for the
@@ -16,6 +16,9 @@ public:
     explicit GaussLegendre(int order);
 
     int order() const { return static_cast<int>(x_.size()); }
+    /// Node k ∈ [0, order) on [−1, 1] (ascending) and its weight.
+    double node(int k) const { return x_[static_cast<std::size_t>(k)]; }
+    double weight(int k) const { return w_[static_cast<std::size_t>(k)]; }
 
     /// ∫_a^b f(x) dx.
     template <typename T, typename F>

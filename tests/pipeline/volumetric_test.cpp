@@ -1,0 +1,176 @@
+// The volumetric integrator through the pipeline (docs/DESIGN.md §9): its
+// scene keys, its layers, its determinism, and its multiple scattering
+// against the path tracer's on block means of the hair's radiance.
+#include "test_util.h"
+
+#include <hairvox/core/error.h>
+#include <hairvox/film/image_compare.h>
+#include <hairvox/pipeline/pipeline.h>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstring>
+
+namespace hairvox {
+namespace {
+
+Scene smallVolumetric(std::uint32_t strands = 1500, std::uint32_t size = 64) {
+    Scene scene = defaultScene();
+    scene.groom.procedural.strands = strands;
+    scene.camera.width = scene.camera.height = size;
+    scene.integrator = Integrator::Volumetric;
+    scene.output = {};
+    return scene;
+}
+
+SceneRender render(const Scene& scene, const test::TempDir& dir, int threads = 0) {
+    PipelineOptions options;
+    options.tableCacheDir = dir / "cache";
+    options.threads = threads;
+    return renderScene(scene, options, false);
+}
+
+double layerSum(const Film& film, const std::string& name) {
+    const FilmLayer& layer = film.layer(name);
+    double sum = 0;
+    for (std::size_t p = 0; p < film.pixelCount(); ++p) {
+        const Rgb v = layer.rgb(p);
+        sum += double(v.r) + double(v.g) + double(v.b);
+    }
+    return sum;
+}
+
+std::string errorOf(const nlohmann::json& integrator) {
+    nlohmann::json j = nlohmann::json::parse(defaultSceneJson());
+    j["integrator"] = integrator;
+    try {
+        parseScene(j, "scene.json", "/");
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+TEST(Volumetric, SceneKeysAreReadAndCheckedPerIntegrator) {
+    nlohmann::json j = nlohmann::json::parse(defaultSceneJson());
+    j["integrator"] = {{"type", "volumetric"},    {"paths", 1000},        {"cell_voxels", 3},
+                       {"theta_bins", 8},         {"azimuthal_order", 2}, {"max_depth", 40},
+                       {"roulette_depth", 5},     {"seed", 9},            {"transport", "fibers"}};
+    const Scene s = parseScene(j, "scene.json", "/");
+    EXPECT_EQ(s.integrator, Integrator::Volumetric);
+    EXPECT_EQ(s.volumetric.paths, 1000u);
+    EXPECT_EQ(s.volumetric.cache.cellVoxels, 3);
+    EXPECT_EQ(s.volumetric.cache.basis.thetaBins, 8);
+    EXPECT_EQ(s.volumetric.cache.basis.azimuthalOrder, 2);
+    EXPECT_EQ(s.volumetric.maxDepth, 40u);
+    EXPECT_EQ(s.volumetric.rouletteDepth, 5u);
+    EXPECT_EQ(s.volumetric.seed, 9u);
+    EXPECT_EQ(s.volumetric.transport, VolumetricTransport::Fibers);
+
+    EXPECT_NE(errorOf({{"type", "volumetric"}, {"theta_bins", 1}})
+                  .find("/integrator/theta_bins: expected an integer in [2, 64], got 1"),
+              std::string::npos);
+    EXPECT_NE(errorOf({{"type", "volumetric"}, {"cell_voxels", 17}}).find("/integrator/cell_voxels"),
+              std::string::npos);
+    EXPECT_NE(errorOf({{"type", "volumetric"}, {"azimuthal_order", 9}})
+                  .find("/integrator/azimuthal_order"),
+              std::string::npos);
+    EXPECT_NE(errorOf({{"type", "volumetric"}, {"paths_per_cell", -1}})
+                  .find("/integrator/paths_per_cell"),
+              std::string::npos);
+    EXPECT_NE(errorOf({{"type", "volumetric"}, {"paths", "many"}}).find("/integrator/paths"),
+              std::string::npos);
+    EXPECT_NE(errorOf({{"type", "volumetric"}, {"transport", "photons"}})
+                  .find("/integrator/transport"),
+              std::string::npos);
+    // A key of another integrator names the one it belongs to.
+    EXPECT_NE(errorOf({{"type", "volumetric"}, {"spp", 4}})
+                  .find("/integrator/spp: applies to the \"path\" integrator only"),
+              std::string::npos);
+    EXPECT_NE(errorOf({{"type", "path"}, {"theta_bins", 8}})
+                  .find("applies to the \"volumetric\" integrator only"),
+              std::string::npos);
+}
+
+TEST(Volumetric, RendersSingleAndMultipleScatteringLayers) {
+    test::TempDir dir;
+    Scene scene = smallVolumetric();
+    scene.volumetric.paths = 40000;
+    const SceneRender r = render(scene, dir);
+    ASSERT_TRUE(r.volumetric.has_value());
+    EXPECT_EQ(r.volumetric->paths, 40000u);
+    EXPECT_GT(r.volumetric->cells, 0u);
+    EXPECT_GT(r.volumetric->crossings, r.volumetric->paths);
+    double direct = 0;
+    for (const char* name : {"direct_R", "direct_TT", "direct_TRT"})
+        direct += layerSum(r.film, name);
+    const double multiple = layerSum(r.film, "multiple");
+    EXPECT_TRUE(std::isfinite(multiple));
+    // The default scene's light hair: multiple scattering is a large share of
+    // the hair's radiance (the path tracer: 69% of the key-lit hair's).
+    EXPECT_GT(multiple, 0.2 * direct);
+    EXPECT_LT(multiple, 5.0 * direct);
+}
+
+TEST(Volumetric, DarkHairScattersLessThanLightHair) {
+    test::TempDir dir;
+    const auto ratio = [&](float eumelanin) {
+        Scene scene = smallVolumetric();
+        scene.volumetric.paths = 20000;
+        scene.fiber.sigma_a = FiberParams::sigmaFromMelanin(eumelanin, 0.0f);
+        const SceneRender r = render(scene, dir);
+        double direct = 0;
+        for (const char* name : {"direct_R", "direct_TT", "direct_TRT"})
+            direct += layerSum(r.film, name);
+        return layerSum(r.film, "multiple") / direct;
+    };
+    const double light = ratio(0.12f), dark = ratio(4.0f);
+    EXPECT_GT(light, 0.2);
+    // Through a dark fiber little but R's few percent survives a scattering:
+    // multiple scattering falls to a small fraction of single (measured 0.66
+    // and 0.081).
+    EXPECT_LT(dark, 0.2 * light) << "light " << light << ", dark " << dark;
+}
+
+TEST(Volumetric, SameBytesForAnyThreadCount) {
+    test::TempDir dir;
+    Scene scene = smallVolumetric(800, 48);
+    scene.volumetric.paths = 20000;
+    const SceneRender one = render(scene, dir, 1), two = render(scene, dir, 2);
+    for (const std::string_view name : {std::string_view("multiple"), Film::kBeauty}) {
+        const std::vector<float> a = one.film.layer(name).dense(), b = two.film.layer(name).dense();
+        ASSERT_EQ(a.size(), b.size());
+        EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0) << name;
+    }
+}
+
+// The hair's radiance against the path tracer's, block means (the issue's
+// measure): the default groom, thinned, at 96², full depth; dual scattering
+// beside it.
+TEST(VolumetricSlow, HairRadianceMatchesThePathTracerOnBlockMeans) {
+    test::TempDir dir;
+    Scene scene = smallVolumetric(1500, 96);
+    const Film volumetric = render(scene, dir).film;
+    scene.integrator = Integrator::DualScattering;
+    const Film ds = render(scene, dir).film;
+    scene.integrator = Integrator::Path;
+    scene.pathTrace.spp = 256;
+    const Film pt = render(scene, dir).film;
+    constexpr int kBlock = 4;
+    const ComparedImage reference = hairRadianceOf(pt).boxFiltered(kBlock);
+    const ImageError e = *compareImages(hairRadianceOf(volumetric).boxFiltered(kBlock), reference);
+    const ImageError d = *compareImages(hairRadianceOf(ds).boxFiltered(kBlock), reference);
+    std::cout << "against the path tracer (96², 4x4 blocks, its noise " << e.noiseFloorL1
+              << "): volumetric rel L1 " << e.relL1 << ", bias " << e.relBias
+              << "; dual scattering " << d.relL1 << ", bias " << d.relBias << "\n";
+    // Measured: volumetric 0.051 (bias −0.9%), dual scattering 0.20, the
+    // path tracer's own noise 0.030.
+    EXPECT_LT(std::abs(e.relBias), 0.04);
+    EXPECT_LT(e.relL1, 0.08);
+    EXPECT_LT(e.relL1, 0.5 * d.relL1);
+}
+
+} // namespace
+} // namespace hairvox

@@ -1,0 +1,169 @@
+// hairvox volumetric: the fiber grid as an anisotropic participating medium
+// (docs/DESIGN.md §9; Jakob et al. 2010, "A radiative transfer framework for
+// rendering materials with anisotropic structure"; Moon, Walter & Marschner
+// 2008 trace their light paths through such a volume of hair).
+//
+// Extinction. A ray of direction ω through fibers of diameter D standing k
+// hairs each (strands/fiber_scale.h) meets
+//     σ_t(x, ω) = k·D·λ(x)·E_x[cos θ],   cos θ = |ω × u|,
+// fibers per unit length: the rate of the global term's n (DESIGN.md §5). E_x
+// is over the fibers' tangents u at x, estimated from the voxel's mean tangent
+// o = E[u] as the grid global term's coherence blend does
+// (transmittance/grid_global_term.h, OrientationModel::CoherenceBlend): with
+// the coherence c = |o|,
+//     E[cos θ] ≈ c·cos θ(ω, o/c) + (1 − c)·π/4,
+// π/4 being the mean of cos θ over fibers of uniformly random direction.
+// Reconstruction is piecewise constant: voxel v's values hold in the box of
+// one voxel around its vertex, [v − ½, v + ½)·h (the splat's total length
+// Σ λ_v h³ is kept; the trilinear field of the global term would cost eight
+// lookups per tentative collision for the same integral).
+//
+// Collisions. sampleCollision() draws the distance to the next fiber met with
+// delta tracking (Woodcock): the ray walks the fiber grid's 8³ blocks
+// (core/grid_traversal.h), skipping those without fibers, and inside a block
+// proposes collisions at the block's majorant max_v σ_v·(c_v + (1 − c_v)π/4),
+// accepting each with probability σ_t(x, ω)/majorant. Unbiased for any
+// majorant that bounds σ_t, which this one does for every ω.
+//
+// Scattering. The collision meets one fiber, drawn in proportion to the
+// cross-section it shows the ray: the voxel's mean direction u = o/c with
+// probability c·cos θ(ω, o/c)/E[cos θ]; otherwise a fiber of uniformly random
+// direction weighted by its cos θ (rejection from the sphere, acceptance π/4).
+// Its type is drawn by the voxel's type fractions f_t (fiber_grid.h).
+#pragma once
+
+#include <hairvox/core/grid_traversal.h>
+#include <hairvox/core/rng.h>
+#include <hairvox/core/vecmath.h>
+#include <hairvox/strands/fiber_scale.h>
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <ostream>
+#include <vector>
+
+namespace hairvox {
+
+struct FiberGrid;
+
+/// A fiber met by a ray in the medium.
+struct MediumCollision {
+    float t = 0;             ///< distance along the ray
+    Vec3f position{0.0f};
+    Vec3f tangent{0.0f, 1.0f, 0.0f}; ///< unit u of the fiber met (root → tip)
+    std::uint8_t fiberType = 0;
+};
+
+class FiberMedium {
+public:
+    /// The medium of `grid` (whose fiber scale gives k and D). Keeps a
+    /// reference to the grid, which must outlive it.
+    explicit FiberMedium(const FiberGrid& grid);
+
+    /// σ_t(x, ω) (1/length): fibers met per unit length by a ray of unit
+    /// direction ω at x; 0 outside the hair.
+    float extinction(const Vec3f& x, const Vec3f& omega) const;
+
+    /// The next fiber a ray from `origin` along unit `dir` meets before
+    /// `tMax`, or nothing (the ray leaves the hair, or reaches tMax first).
+    /// Draws from `rng` (delta tracking and the fiber's orientation and type).
+    std::optional<MediumCollision> sampleCollision(const Vec3f& origin, const Vec3f& dir, float tMax,
+                                                   Pcg32& rng) const;
+
+    /// Calls visit(value index, voxel, tEnter, tExit) for every active voxel
+    /// the segment origin + t·dir, t ∈ [0, tEnd], crosses, in order (unit
+    /// dir; voxels hold their value over the box around their vertex). Blocks
+    /// without fibers are passed whole.
+    template <typename Visit>
+    void walkVoxels(const Vec3f& origin, const Vec3f& dir, float tEnd, Visit&& visit) const;
+
+    /// World-space box of every voxel's extent.
+    const Bounds3f& bounds() const { return bounds_; }
+    float voxelSize() const { return h_; }
+    const FiberGrid& grid() const { return *grid_; }
+    std::size_t fiberTypeCount() const { return types_; }
+
+private:
+    /// The block at block coordinates b, or -1.
+    std::int32_t blockAt(const glm::ivec3& b) const;
+    /// Index-space coordinates of a block's first voxel.
+    glm::ivec3 blockOrigin(std::int32_t block) const;
+    /// The value index of voxel v (index space) in block `block`, or -1.
+    std::int64_t voxelIn(std::int32_t block, const glm::ivec3& v) const;
+    /// The value index of the voxel whose box holds x (shifted index space
+    /// q = x/h + ½), or -1.
+    std::int64_t voxelAt(const Vec3f& q) const;
+    /// Calls visit(block, tEnter, tExit) for the blocks with fibers that the
+    /// segment crosses, in order, while visit returns true.
+    template <typename Visit>
+    void walkBlocks(const Vec3f& origin, const Vec3f& dir, float tEnd, Visit&& visit) const;
+    /// The fiber tangent and type met by a ray of direction ω in voxel `v`.
+    void sampleFiber(std::size_t v, const Vec3f& omega, Pcg32& rng, MediumCollision& out) const;
+    /// E_v[cos θ] of voxel v toward ω.
+    float meanCosTheta(std::size_t v, const Vec3f& omega) const;
+
+    const FiberGrid* grid_;
+    float h_ = 1, kD_ = 0;
+    std::size_t types_ = 1;
+    Bounds3f bounds_;
+    /// Blocks in a dense array over the box of block coordinates
+    /// [blockMin_, blockMin_ + blockDims_): index into grid_->blocks, or -1.
+    glm::ivec3 blockMin_{0}, blockDims_{0};
+    std::vector<std::int32_t> blockIndex_;
+    std::vector<float> majorant_;                       ///< per block
+    std::vector<std::array<std::uint16_t, 8>> prefix_; ///< per block: active voxels before each mask word
+};
+
+std::ostream& operator<<(std::ostream& os, const MediumCollision& c);
+
+// ---------------------------------------------------------------------------
+
+template <typename Visit>
+void FiberMedium::walkBlocks(const Vec3f& origin, const Vec3f& dir, float tEnd,
+                             Visit&& visit) const {
+    if (blockIndex_.empty())
+        return;
+    // The line in block coordinates: b(t) = (x(t)/h + ½)/8, t in world units.
+    constexpr float kBlockDim = 8.0f;
+    const GridLine<float> line((origin / h_ + 0.5f) / kBlockDim, dir / (h_ * kBlockDim));
+    float t0 = 0, t1 = tEnd;
+    for (int i = 0; i < 3; ++i) {
+        const auto lo = float(blockMin_[i]), hi = float(blockMin_[i] + blockDims_[i]);
+        if (line.invDir[i] == 0.0f) {
+            if (line.origin[i] < lo || line.origin[i] > hi)
+                return;
+            continue;
+        }
+        float a = (lo - line.origin[i]) * line.invDir[i], b = (hi - line.origin[i]) * line.invDir[i];
+        if (a > b)
+            std::swap(a, b);
+        t0 = std::max(t0, a);
+        t1 = std::min(t1, b);
+    }
+    if (!(t0 < t1))
+        return;
+    traverseCells(line, t0, t1, blockMin_, blockMin_ + blockDims_ - 1,
+                  [&](const glm::ivec3& cell, float tEnter, float tExit) {
+                      const std::int32_t block = blockAt(cell);
+                      return block < 0 || visit(block, tEnter, tExit);
+                  });
+}
+
+template <typename Visit>
+void FiberMedium::walkVoxels(const Vec3f& origin, const Vec3f& dir, float tEnd,
+                             Visit&& visit) const {
+    const GridLine<float> line(origin / h_ + 0.5f, dir / h_);
+    walkBlocks(origin, dir, tEnd, [&](std::int32_t block, float tEnter, float tExit) {
+        const glm::ivec3 lo = blockOrigin(block);
+        traverseCells(line, tEnter, tExit, lo, lo + 7,
+                      [&](const glm::ivec3& v, float t0, float t1) {
+                          if (const std::int64_t i = voxelIn(block, v); i >= 0)
+                              visit(std::size_t(i), v, t0, t1);
+                          return true;
+                      });
+        return true;
+    });
+}
+
+} // namespace hairvox

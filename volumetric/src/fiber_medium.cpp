@@ -1,0 +1,193 @@
+#include <hairvox/volumetric/fiber_medium.h>
+
+#include <hairvox/core/error.h>
+#include <hairvox/core/grid_traversal.h>
+#include <hairvox/core/math.h>
+#include <hairvox/core/sampling.h>
+#include <hairvox/voxelize/fiber_grid.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <limits>
+
+namespace hairvox {
+
+namespace {
+
+constexpr int kBlockDim = FiberBlock::kDim; // 8
+constexpr float kQuarterPi = float(Pi / 4.0);
+
+} // namespace
+
+FiberMedium::FiberMedium(const FiberGrid& grid)
+    : grid_(&grid)
+    , h_(float(grid.info.voxelSize))
+    , kD_(grid.info.fiberScale.ribbonWidth())
+    , types_(grid.fiberTypeCount()) {
+    if (!(h_ > 0))
+        throw std::invalid_argument("FiberMedium: the grid has no voxel size");
+    if (grid.blocks.empty())
+        return;
+    glm::ivec3 lo(std::numeric_limits<int>::max()), hi(std::numeric_limits<int>::min());
+    for (const FiberBlock& b : grid.blocks) {
+        const glm::ivec3 c(b.origin.x() / kBlockDim, b.origin.y() / kBlockDim,
+                           b.origin.z() / kBlockDim);
+        lo = glm::min(lo, c);
+        hi = glm::max(hi, c);
+    }
+    blockMin_ = lo;
+    blockDims_ = hi - lo + 1;
+    const std::uint64_t cells =
+        std::uint64_t(blockDims_.x) * std::uint64_t(blockDims_.y) * std::uint64_t(blockDims_.z);
+    // A grid of at most 2^31 voxels a side has at most (2^28)^3 blocks in its
+    // box; a box this size would hold a few active blocks spread over a huge
+    // volume, which the grid's own memory budget already refused.
+    if (cells > (1ull << 30))
+        throw InputError(strCat("the fiber grid spans ", blockDims_.x, " x ", blockDims_.y, " x ",
+                                blockDims_.z,
+                                " blocks of 8 voxels: too sparse a groom for the volumetric "
+                                "integrator; raise the voxel size"));
+    blockIndex_.assign(cells, -1);
+    majorant_.resize(grid.blocks.size());
+    prefix_.resize(grid.blocks.size());
+    using Word = openvdb::Index64;
+    for (std::size_t b = 0; b < grid.blocks.size(); ++b) {
+        const FiberBlock& block = grid.blocks[b];
+        const glm::ivec3 c = glm::ivec3(block.origin.x(), block.origin.y(), block.origin.z()) /
+                                 kBlockDim -
+                             blockMin_;
+        blockIndex_[(std::size_t(c.x) * std::size_t(blockDims_.y) + std::size_t(c.y)) *
+                        std::size_t(blockDims_.z) +
+                    std::size_t(c.z)] = static_cast<std::int32_t>(b);
+        std::uint16_t count = 0;
+        for (int w = 0; w < 8; ++w) {
+            prefix_[b][std::size_t(w)] = count;
+            count = static_cast<std::uint16_t>(
+                count + openvdb::util::CountOn(block.active.getWord<Word>(openvdb::Index(w))));
+        }
+        float maxSigma = 0;
+        FiberGrid::forEachVoxelOf(block, [&](std::size_t v, const openvdb::Coord&) {
+            const float coherence = std::min(1.0f, grid.orientation[v].length());
+            maxSigma = std::max(maxSigma, grid.density[v] * (coherence + (1.0f - coherence) * kQuarterPi));
+        });
+        majorant_[b] = kD_ * maxSigma;
+        const Vec3f lo3 = (Vec3f(block.origin.x(), block.origin.y(), block.origin.z()) - 0.5f) * h_;
+        bounds_.extend(lo3);
+        bounds_.extend(lo3 + float(kBlockDim) * h_);
+    }
+}
+
+std::int32_t FiberMedium::blockAt(const glm::ivec3& c) const {
+    const glm::ivec3 b = c - blockMin_;
+    if (b.x < 0 || b.y < 0 || b.z < 0 || b.x >= blockDims_.x || b.y >= blockDims_.y ||
+        b.z >= blockDims_.z)
+        return -1;
+    return blockIndex_[(std::size_t(b.x) * std::size_t(blockDims_.y) + std::size_t(b.y)) *
+                           std::size_t(blockDims_.z) +
+                       std::size_t(b.z)];
+}
+
+glm::ivec3 FiberMedium::blockOrigin(std::int32_t block) const {
+    const openvdb::Coord& o = grid_->blocks[std::size_t(block)].origin;
+    return {o.x(), o.y(), o.z()};
+}
+
+std::int64_t FiberMedium::voxelIn(std::int32_t block, const glm::ivec3& v) const {
+    const FiberBlock& fb = grid_->blocks[std::size_t(block)];
+    const auto offset = static_cast<openvdb::Index>(((v.x & 7) << 6) | ((v.y & 7) << 3) | (v.z & 7));
+    using Word = openvdb::Index64;
+    const Word word = fb.active.getWord<Word>(offset >> 6);
+    const Word bit = Word(1) << (offset & 63);
+    if (!(word & bit))
+        return -1;
+    return std::int64_t(fb.first) + prefix_[std::size_t(block)][offset >> 6] +
+           std::popcount(word & (bit - 1));
+}
+
+std::int64_t FiberMedium::voxelAt(const Vec3f& q) const {
+    const glm::ivec3 v(floorToInt(q.x), floorToInt(q.y), floorToInt(q.z));
+    const std::int32_t block = blockAt(glm::ivec3(v.x >> 3, v.y >> 3, v.z >> 3));
+    return block < 0 ? -1 : voxelIn(block, v);
+}
+
+float FiberMedium::meanCosTheta(std::size_t v, const Vec3f& omega) const {
+    // c·cos θ(ω, o/c) = |ω × o|, so the blend needs no normalisation.
+    const Vec3f o(grid_->orientation[v].x(), grid_->orientation[v].y(), grid_->orientation[v].z());
+    const float c = std::min(1.0f, glm::length(o));
+    return glm::length(glm::cross(omega, o)) + (1.0f - c) * kQuarterPi;
+}
+
+float FiberMedium::extinction(const Vec3f& x, const Vec3f& omega) const {
+    const std::int64_t v = voxelAt(x / h_ + 0.5f);
+    return v < 0 ? 0.0f : kD_ * grid_->density[std::size_t(v)] * meanCosTheta(std::size_t(v), omega);
+}
+
+void FiberMedium::sampleFiber(std::size_t v, const Vec3f& omega, Pcg32& rng,
+                              MediumCollision& out) const {
+    const Vec3f o(grid_->orientation[v].x(), grid_->orientation[v].y(), grid_->orientation[v].z());
+    const float len = glm::length(o);
+    const float c = std::min(1.0f, len);
+    const float coherent = glm::length(glm::cross(omega, o));
+    const float isotropic = (1.0f - c) * kQuarterPi;
+    if (len > 0 && rng.uniformFloat() * (coherent + isotropic) < coherent) {
+        out.tangent = o / len;
+    } else {
+        // A uniformly random direction, kept with probability cos θ = |ω × u|.
+        for (;;) {
+            const Vec3f u = uniformSphere(rng.uniformFloat(), rng.uniformFloat());
+            if (rng.uniformFloat() < glm::length(glm::cross(omega, u))) {
+                out.tangent = u;
+                break;
+            }
+        }
+    }
+    out.fiberType = 0;
+    if (types_ > 1) {
+        float xi = rng.uniformFloat(), sum = 0;
+        for (std::size_t t = 0; t < types_; ++t) {
+            sum += grid_->typeFraction[t][v];
+            if (xi < sum || t + 1 == types_) {
+                out.fiberType = static_cast<std::uint8_t>(t);
+                break;
+            }
+        }
+    }
+}
+
+std::optional<MediumCollision> FiberMedium::sampleCollision(const Vec3f& origin, const Vec3f& dir,
+                                                            float tMax, Pcg32& rng) const {
+    std::optional<MediumCollision> hit;
+    walkBlocks(origin, dir, tMax, [&](std::int32_t block, float tEnter, float tExit) {
+        const float majorant = majorant_[std::size_t(block)];
+        if (!(majorant > 0))
+            return true;
+        for (float t = tEnter;;) {
+            t -= std::log1p(-rng.uniformFloat()) / majorant;
+            if (!(t < tExit))
+                return true;
+            const Vec3f x = origin + t * dir;
+            const std::int64_t v = voxelAt(x / h_ + 0.5f);
+            if (v < 0)
+                continue;
+            const float sigma =
+                kD_ * grid_->density[std::size_t(v)] * meanCosTheta(std::size_t(v), dir);
+            if (rng.uniformFloat() * majorant < sigma) {
+                MediumCollision c;
+                c.t = t;
+                c.position = x;
+                sampleFiber(std::size_t(v), dir, rng, c);
+                hit = c;
+                return false;
+            }
+        }
+    });
+    return hit;
+}
+
+std::ostream& operator<<(std::ostream& os, const MediumCollision& c) {
+    return os << "MediumCollision(t=" << c.t << ", x=" << c.position << ", u=" << c.tangent
+              << ", type=" << int(c.fiberType) << ")";
+}
+
+} // namespace hairvox
