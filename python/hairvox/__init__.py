@@ -14,6 +14,7 @@ from collections.abc import Mapping as _Mapping
 
 from ._hairvox import (
     FiberGrid,
+    FrameReuse,
     Groom,
     HairvoxWarning,
     Layers,
@@ -21,6 +22,7 @@ from ._hairvox import (
     Render,
     __version__,
     compare,
+    default_scene,
     generate,
     interrupt,
     load_groom,
@@ -35,6 +37,7 @@ _Mapping.register(Layers)
 
 __all__ = [
     "FiberGrid",
+    "FrameReuse",
     "Groom",
     "HairvoxWarning",
     "Layers",
@@ -42,6 +45,7 @@ __all__ = [
     "Render",
     "__version__",
     "compare",
+    "default_scene",
     "generate",
     "interrupt",
     "load_groom",

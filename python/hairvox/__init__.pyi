@@ -124,6 +124,12 @@ class Render:
     ) -> npt.NDArray[np.uint8]:
         """The PNG preview's pixels, (height, width, 3) sRGB; a new array."""
 
+class FrameReuse:
+    """What consecutive renders given it share (the fiber grid, the lights'
+    preparation) where unchanged; the images are the same bytes."""
+
+    def __init__(self) -> None: ...
+
 def render(
     scene: SceneArg = None,
     *,
@@ -135,8 +141,12 @@ def render(
     seed: Optional[int] = None,
     threads: Optional[int] = None,
     progress: ProgressArg = None,
+    reuse: Optional[FrameReuse] = None,
 ) -> Render:
     """Renders a scene (the GIL released); nothing is written until Render.save()."""
+
+def default_scene() -> dict[str, Any]:
+    """The embedded default scene as a dict in the scene file's schema."""
 
 def read_exr(path: PathLike) -> dict[str, npt.NDArray[np.float32]]:
     """An EXR's layers, named as Render.layers names them."""

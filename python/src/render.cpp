@@ -437,6 +437,22 @@ each. Returns the paths written. Never overwrites the scene or groom file.)doc")
                           " layers)");
         });
 
+    py::class_<FrameReuse>(m, "FrameReuse", R"doc(What consecutive renders share: pass the same
+FrameReuse to render(reuse=...) and each render takes from the one before the
+fiber grid and the lights' preparation wherever what they are made of is
+unchanged (keys are contents: the groom's points, the lights, the settings),
+as `hairvox render a.json b.json ...` does for a sequence. A sweep over
+colour keeps the grid; a turntable keeps the grid and the lights. The images
+are the same bytes as rendered alone. Holds one render's groom, grid and
+light terms between calls; drop it to free them.)doc")
+        .def(py::init<>());
+
+    m.def(
+        "default_scene",
+        [] { return py::module_::import("json").attr("loads")(std::string(defaultSceneJson())); },
+        R"doc(The embedded default scene (data/scenes/default.json) as a dict in the scene
+file's schema: a starting point to change and pass to render().)doc");
+
     m.def(
         "read_exr",
         [](py::handle path) {
@@ -461,7 +477,7 @@ ValueError naming the file if it cannot be read.)doc");
         "render",
         [](py::object sceneArg, py::object width, py::object height, py::object integrator,
            py::object mode, py::object spp, py::object seed, py::object threads,
-           py::object progressArg) {
+           py::object progressArg, py::object reuseArg) {
             Scene scene = sceneOf(sceneArg);
             const std::filesystem::path sceneFile =
                 isPathLike(sceneArg) ? pathArg(sceneArg, "scene") : std::filesystem::path();
@@ -471,8 +487,15 @@ ValueError naming the file if it cannot be read.)doc");
                 options.threads = int(intArg(threads, "threads", 0, 1024));
             const Progress progress = Progress::from(progressArg);
             options.progress = progress.bars;
+            FrameReuse* reuse = nullptr;
+            if (!reuseArg.is_none()) {
+                if (!py::isinstance<FrameReuse>(reuseArg))
+                    throw InputError(strCat("reuse: expected None or a hairvox.FrameReuse, got ",
+                                            typeName(reuseArg)));
+                reuse = &reuseArg.cast<FrameReuse&>();
+            }
             SceneRender rendered =
-                longCall(progress, [&] { return renderScene(scene, options, false); });
+                longCall(progress, [&] { return renderScene(scene, options, false, reuse); });
             if (rendered.pathTrace && rendered.pathTrace->interrupted)
                 throw Interrupted(strCat("interrupted after ", rendered.pathTrace->spp,
                                          " samples per pixel; nothing was saved"));
@@ -484,6 +507,7 @@ ValueError naming the file if it cannot be read.)doc");
         py::arg("height") = py::none(), py::arg("integrator") = py::none(),
         py::arg("mode") = py::none(), py::arg("spp") = py::none(), py::arg("seed") = py::none(),
         py::arg("threads") = py::none(), py::arg("progress") = py::none(),
+        py::arg("reuse") = py::none(),
         R"doc(Renders a scene; returns a Render (nothing is written until Render.save()).
 
 scene: None (the embedded default scene), a scene file path, a dict in the
@@ -496,6 +520,8 @@ spp, seed: the path integrator's samples per pixel and seed.
 threads: worker threads (0 or None: all cores).
 progress: None, True (the CLI's bars on stderr) or a callable
 (stage, done, total), called on this thread while the render runs.
+reuse: a FrameReuse shared by consecutive renders (the dual-scattering
+integrator takes the grid and lights of the render before where unchanged).
 
 The GIL is released while rendering. Ctrl-C raises KeyboardInterrupt once the
 render has stopped; bad input raises ValueError with the CLI's message.)doc");

@@ -1,6 +1,7 @@
 """hairvox.render and hairvox.Render: the same pixels and files as the CLI,
 layers that are views (no copy), the report, save()'s outputs."""
 
+import copy
 import gc
 import json
 
@@ -177,3 +178,29 @@ def test_the_default_scene_renders_from_python(cli, tmp_path):
     r.save(exr=tmp_path / "py.exr")
     cli("render", "--width", 64, "--height", 64, "--exr", tmp_path / "cli.exr", "--quiet")
     assert (tmp_path / "py.exr").read_bytes() == (tmp_path / "cli.exr").read_bytes()
+    # default_scene() is that scene as a dict.
+    as_dict = hairvox.render(hairvox.default_scene(), width=64, height=64)
+    np.testing.assert_array_equal(as_dict.layers["beauty"], r.layers["beauty"])
+
+
+def test_frame_reuse_shares_the_grid_between_renders():
+    reuse = hairvox.FrameReuse()
+    first = hairvox.render(small_scene(), reuse=reuse)
+    assert not first.report["grid_reused"]
+    # Another colour: the same grid, the lights prepared again; the same image as alone.
+    darker = small_scene(fiber={**small_scene()["fiber"],
+                                "melanin": {"eumelanin": 2.0, "pheomelanin": 0.2}})
+    second = hairvox.render(darker, reuse=reuse)
+    assert second.report["grid_reused"]
+    assert [light["reused"] for light in second.report["lights"]] == [False, False]
+    alone = hairvox.render(darker)
+    for name in alone.layers:
+        np.testing.assert_array_equal(second.layers[name], alone.layers[name], err_msg=name)
+    # The camera moves: the grid and both lights are kept.
+    moved = copy.deepcopy(darker)
+    moved["camera"]["position"] = [0.45, 0.05, 0.65]
+    third = hairvox.render(moved, reuse=reuse)
+    assert third.report["grid_reused"]
+    assert [light["reused"] for light in third.report["lights"]] == [True, True]
+    with pytest.raises(ValueError, match="reuse: expected None or a hairvox.FrameReuse"):
+        hairvox.render(small_scene(), reuse=True)
