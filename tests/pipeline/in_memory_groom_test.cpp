@@ -36,9 +36,12 @@ Groom attributedGroom() {
     return groom;
 }
 
+/// The default scene at 64², its head a sphere instead of the mannequin mesh.
 Scene smallScene(const std::string& name) {
     Scene scene = defaultScene();
     scene.name = name;
+    scene.meshes.clear();
+    scene.head = Head{};
     scene.camera.width = scene.camera.height = 64;
     scene.output.exr.clear();
     scene.output.png.clear();
