@@ -156,3 +156,12 @@ def test_compare_renders_and_files(tmp_path):
     assert against_path["noisy_reference"] and against_path["noise_floor_l1"] > 0
     beauty = hairvox.compare(grid, exact, what="beauty", mask="A")
     assert beauty["rel_l1"] > 0
+
+
+def test_an_internal_error_is_a_runtime_error(monkeypatch):
+    # Without pyopenvdb the grids cannot be handed over: not bad input, an
+    # environment the module cannot work in — RuntimeError, saying what to install.
+    grid = hairvox.voxelize(hairvox.generate("straight", strands=20), voxels_across=16)
+    monkeypatch.setitem(__import__("sys").modules, "pyopenvdb", None)
+    with pytest.raises(RuntimeError, match="python3-openvdb"):
+        grid.to_openvdb()
