@@ -13,6 +13,7 @@ packages=(
   libgtest-dev libbenchmark-dev
   clang libclang-rt-14-dev
   python3-numpy python3-matplotlib
+  python3-dev pybind11-dev libboost-python1.74-dev python3-pytest
 )
 
 missing=()

@@ -9,7 +9,7 @@
 #include <hairvox/core/error.h>
 #include <hairvox/film/image_compare.h>
 #include <hairvox/film/image_file.h>
-#include <hairvox/pipeline/pipeline.h>
+#include <hairvox/pipeline/compare.h>
 
 #include <algorithm>
 #include <array>
@@ -86,26 +86,10 @@ void writeFigure(const CompareOptions& opt, const Film& estimateFilm, const Film
 void runCompare(const CompareOptions& opt) {
     const Film estimateFilm = filmFromExr(readExr(opt.estimate)),
                referenceFilm = filmFromExr(readExr(opt.reference));
-    const auto load = [&](const std::string& path) {
-        const Film& film = path == opt.estimate ? estimateFilm : referenceFilm;
-        try {
-            if (!opt.layers.empty())
-                return ComparedImage::fromFilm(film, opt.layers, opt.mask);
-            if (opt.what == "hair") {
-                ComparedImage image = hairRadianceOf(film);
-                image.mask = film.layer(opt.mask).dense();
-                return image;
-            }
-            return ComparedImage::beautyOf(film, opt.mask);
-        } catch (const std::out_of_range& e) {
-            throw InputError(strCat(path, ": ", e.what(),
-                                    " (a render with output.layers keeps only some layers: "
-                                    "compare what both have with --what beauty --mask A, or "
-                                    "--layers)"));
-        }
-    };
-    const ComparedImage estimate = load(opt.estimate).boxFiltered(opt.block),
-                        reference = load(opt.reference).boxFiltered(opt.block);
+    const CompareSelection selection{*kComparedValueNames.parse(opt.what), opt.layers, opt.mask};
+    const ComparedImage
+        estimate = comparedImage(estimateFilm, selection, opt.estimate).boxFiltered(opt.block),
+        reference = comparedImage(referenceFilm, selection, opt.reference).boxFiltered(opt.block);
     const std::optional<ImageError> e = compareImages(estimate, reference);
     if (!e)
         throw InputError(strCat(opt.reference, ": no pixel with ", opt.mask,
@@ -151,7 +135,7 @@ void addCompareCommand(CLI::App& app) {
     cmd->add_option("--what", opt->what,
                     "hair: the hair's radiance (direct + multiple scattering); beauty: the image")
         ->capture_default_str()
-        ->check(CLI::IsMember({"hair", "beauty"}));
+        ->check(CLI::IsMember(kComparedValueNames.names()));
     cmd->add_option(
            "--layers", opt->layers,
            "Compare the sum of these RGB layers instead (e.g. direct_R,direct_TT,direct_TRT; "

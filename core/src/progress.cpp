@@ -5,14 +5,52 @@
 #include <cstdio>
 #include <string>
 #include <unistd.h>
+#include <utility>
+#include <vector>
 
 namespace hairvox {
 
+namespace {
+
+/// The live reporters in creation order, each with its serial number, for
+/// currentProgress(). A reporter is removed (under the mutex) before it is
+/// destroyed, so what the list points to is alive while the mutex is held.
+struct Registry {
+    std::mutex mutex;
+    std::vector<std::pair<const ProgressReporter*, std::uint64_t>> live;
+    std::uint64_t serial = 0;
+
+    static Registry& get() {
+        static Registry registry;
+        return registry;
+    }
+    void add(const ProgressReporter* r) {
+        std::lock_guard lock(mutex);
+        live.emplace_back(r, ++serial);
+    }
+    void remove(const ProgressReporter* r) {
+        std::lock_guard lock(mutex);
+        std::erase_if(live, [r](const auto& entry) { return entry.first == r; });
+    }
+};
+
+} // namespace
+
 bool stderrIsTerminal() { return ::isatty(STDERR_FILENO) == 1; }
+
+std::optional<ProgressSnapshot> currentProgress() {
+    Registry& registry = Registry::get();
+    std::lock_guard lock(registry.mutex);
+    if (registry.live.empty())
+        return std::nullopt;
+    const auto& [reporter, serial] = registry.live.back();
+    return ProgressSnapshot{reporter->title(), reporter->done(), reporter->total(), serial};
+}
 
 ProgressReporter::ProgressReporter(std::string title, std::uint64_t totalWork, bool enabled)
     : title_(std::move(title)), total_(std::max<std::uint64_t>(totalWork, 1)), enabled_(enabled),
       start_(std::chrono::steady_clock::now()) {
+    Registry::get().add(this);
     if (!enabled_)
         return;
     thread_ = std::thread([this] {
@@ -30,7 +68,12 @@ ProgressReporter::ProgressReporter(std::string title, std::uint64_t totalWork, b
 
 ProgressReporter::~ProgressReporter() { finish(); }
 
+std::uint64_t ProgressReporter::done() const {
+    return std::min(done_.load(std::memory_order_relaxed), total_);
+}
+
 void ProgressReporter::finish() {
+    Registry::get().remove(this); // idempotent
     if (!enabled_)
         return;
     {
@@ -65,8 +108,8 @@ std::string duration(double seconds) {
 
 void ProgressReporter::draw(bool final) const {
     constexpr int barWidth = 40;
-    const std::uint64_t done = std::min(done_.load(std::memory_order_relaxed), total_);
-    const double fraction = static_cast<double>(done) / static_cast<double>(total_);
+    const std::uint64_t work = done();
+    const double fraction = static_cast<double>(work) / static_cast<double>(total_);
     const int filled = static_cast<int>(fraction * barWidth);
     char bar[barWidth + 1];
     for (int i = 0; i < barWidth; ++i)
@@ -77,7 +120,7 @@ void ProgressReporter::draw(bool final) const {
     const double elapsed =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
     std::string time = duration(elapsed);
-    if (!final && done > 0) {
+    if (!final && work > 0) {
         double left = elapsed * (1.0 - fraction) / fraction;
         if (const double limit = timeLimit_.load(); limit > 0)
             left = std::min(left, limit - elapsed);

@@ -140,7 +140,9 @@ MemoryEstimate estimateRenderMemory(const Scene& scene) {
     // Per point: the point, its tangent and projection in the rasterizer, the
     // segment bins and splat buckets or the ray-tracing structure.
     constexpr std::uint64_t kBytesPerPoint = 96;
-    if (scene.groom.isProcedural()) {
+    if (scene.groom.inMemory) {
+        m.groom = scene.groom.inMemory->pointCount() * kBytesPerPoint;
+    } else if (scene.groom.isProcedural()) {
         m.groom = std::uint64_t(scene.groom.procedural.strands) *
                   scene.groom.procedural.resolvedPointsPerStrand() * kBytesPerPoint;
     } else {
@@ -238,20 +240,24 @@ RasterSettings rasterSettings(const Scene& scene, const PipelineOptions& options
 SceneGroom loadGroom(const Scene& scene) {
     SceneGroom g;
     const bool procedural = scene.groom.isProcedural();
-    const std::string source = procedural ? "procedural groom" : scene.groom.file.string();
+    const std::string source = procedural ? "procedural groom" : scene.groom.sourceName();
+    SanitizeReport sanitized;
     if (procedural) {
         g.groom = generateGroom(scene.groom.procedural);
+    } else if (scene.groom.inMemory) {
+        g.groom = *scene.groom.inMemory; // its attributes are resolved below, in this copy
+        sanitized = sanitizeGroom(g.groom, source);
     } else {
         LoadedGroom loaded = readGroom(scene.groom.file);
         g.warnings = std::move(loaded.warnings);
-        if (loaded.sanitized.droppedSegments > 0)
-            g.warnings.push_back(
-                strCat("dropped ", loaded.sanitized.droppedSegments, " zero-length segment(s)"));
-        if (loaded.sanitized.droppedStrands > 0)
-            g.warnings.push_back(
-                strCat("dropped ", loaded.sanitized.droppedStrands, " degenerate strand(s)"));
+        sanitized = loaded.sanitized;
         g.groom = std::move(loaded.groom);
     }
+    if (sanitized.droppedSegments > 0)
+        g.warnings.push_back(
+            strCat("dropped ", sanitized.droppedSegments, " zero-length segment(s)"));
+    if (sanitized.droppedStrands > 0)
+        g.warnings.push_back(strCat("dropped ", sanitized.droppedStrands, " degenerate strand(s)"));
     if (std::string note = resolveThickness(g.groom, scene.groom.thickness, scene.fiberScale,
                                             source, g.warnings);
         !note.empty())
@@ -259,7 +265,9 @@ SceneGroom loadGroom(const Scene& scene) {
     g.palette = resolveColors(g.groom, scene.groom.color, scene.fiber, source, g.warnings);
     if (!g.palette.colors.empty())
         g.notes.push_back(strCat(g.palette.size(), " fiber type(s) from the ",
-                                 procedural ? "procedural groom's" : "file's",
+                                 procedural             ? "procedural groom's"
+                                 : scene.groom.inMemory ? "groom's"
+                                                        : "file's",
                                  " colours (groom.color \"use\"): sigma_a replaces the scene's"));
     else if (!g.groom.color.empty())
         g.notes.push_back("per-point colours ignored (groom.color \"ignore\")");
@@ -276,8 +284,7 @@ SplatOptions splatOptions(const Scene& scene, const PipelineOptions& options) {
     splat.voxelSize = scene.voxelSize.value_or(0.0f);
     splat.fiberScale = scene.fiberScale;
     splat.storeOrientationTensor = options.grid.orientation == OrientationModel::Tensor;
-    splat.sourceFile =
-        scene.groom.isProcedural() ? std::string("procedural") : scene.groom.file.string();
+    splat.sourceFile = scene.groom.sourceName();
     splat.showProgress = options.progress;
     if (options.maxMemoryBytes > 0) {
         const std::uint64_t used = estimateRenderMemory(scene).total();
@@ -578,12 +585,12 @@ SceneRender renderRasterized(const Scene& scene, const PipelineOptions& options,
     for (std::size_t l = 0; l < stats.size(); ++l)
         result.lights[l].stats = stats[l];
 
+    if (assets->grid)
+        result.outputAttributes["hairvox:voxel_size"] =
+            std::to_string(assets->grid->info.voxelSize);
     if (writeFiles) {
         const auto start = Clock::now();
-        std::map<std::string, std::string> attributes;
-        if (assets->grid)
-            attributes["hairvox:voxel_size"] = std::to_string(assets->grid->info.voxelSize);
-        result.written = writeOutputs(result.film, scene, attributes);
+        result.written = writeOutputs(result.film, scene, result.outputAttributes);
         result.times.write = secondsSince(start);
     }
     return result;
@@ -652,12 +659,12 @@ SceneRender renderPathTraced(const Scene& scene, const PipelineOptions& options,
     for (const Light& light : scene.lights)
         result.lights.push_back({.name = light.name, .skipped = light.isDark(), .stats = {}});
 
+    result.outputAttributes = {{"hairvox:spp", std::to_string(traced.stats.spp)},
+                               {"hairvox:seed", std::to_string(scene.pathTrace.seed)},
+                               {"hairvox:pathTraceHash", hash}};
     if (writeFiles && traced.stats.spp > previousSpp) {
         start = Clock::now();
-        result.written = writeOutputs(result.film, scene,
-                                      {{"hairvox:spp", std::to_string(traced.stats.spp)},
-                                       {"hairvox:seed", std::to_string(scene.pathTrace.seed)},
-                                       {"hairvox:pathTraceHash", hash}});
+        result.written = writeOutputs(result.film, scene, result.outputAttributes);
         result.times.write = secondsSince(start);
     }
     return result;

@@ -672,7 +672,7 @@ std::ostream& operator<<(std::ostream& os, const Scene& s) {
     if (s.groom.isProcedural())
         os << s.groom.procedural;
     else
-        os << s.groom.file.string() << " (thickness " << toString(s.groom.thickness) << ", color "
+        os << s.groom.sourceName() << " (thickness " << toString(s.groom.thickness) << ", color "
            << toString(s.groom.color) << ")";
     os << ", " << s.fiberScale << ", " << s.fiber << ", " << s.dualScattering << ", "
        << s.lights.size() << " lights";

@@ -1,26 +1,43 @@
+#include <hairvox/core/error.h>
 #include <hairvox/core/math.h>
 #include <hairvox/transmittance/lit_grid.h>
 
+#include <stdexcept>
 #include <vector>
 
 namespace hairvox {
 
-LitGrid evaluateOnFiberGrid(const FiberGrid& grid, const LightGlobalTerm& term) {
-    std::vector<openvdb::Coord> coords;
+VoxelGlobalTerms evaluateAtActiveVoxels(const FiberGrid& grid, const LightGlobalTerm& term) {
     std::vector<GlobalTermQuery> queries;
     const auto xform = openvdb::math::Transform::createLinearTransform(grid.info.voxelSize);
-    coords.reserve(grid.activeVoxelCount());
     queries.reserve(grid.activeVoxelCount());
     grid.forEachVoxel([&](std::size_t i, const openvdb::Coord& c) {
         const openvdb::Vec3d p = xform->indexToWorld(c);
         const openvdb::Vec3s& o = grid.orientation[i];
-        coords.push_back(c);
         queries.push_back({Vec3f(float(p.x()), float(p.y()), float(p.z())),
                            normalizeOr(Vec3f(o.x(), o.y(), o.z()), Vec3f(0.0f, 1.0f, 0.0f))});
     });
-    std::vector<GlobalTerm> terms(queries.size());
+    VoxelGlobalTerms values;
+    values.terms.resize(queries.size());
+    values.stats = term.evaluate(queries, values.terms);
+    return values;
+}
+
+LitGrid evaluateOnFiberGrid(const FiberGrid& grid, const LightGlobalTerm& term) {
+    return toLitGrid(grid, evaluateAtActiveVoxels(grid, term));
+}
+
+LitGrid toLitGrid(const FiberGrid& grid, const VoxelGlobalTerms& values) {
+    std::vector<openvdb::Coord> coords;
+    coords.reserve(grid.activeVoxelCount());
+    grid.forEachVoxel([&](std::size_t, const openvdb::Coord& c) { coords.push_back(c); });
+    const std::vector<GlobalTerm>& terms = values.terms;
+    if (terms.size() != coords.size())
+        throw std::invalid_argument(
+            strCat("toLitGrid: ", terms.size(), " values for ", coords.size(), " active voxels"));
+    const auto xform = openvdb::math::Transform::createLinearTransform(grid.info.voxelSize);
     LitGrid lit;
-    lit.stats = term.evaluate(queries, terms);
+    lit.stats = values.stats;
 
     lit.n = openvdb::FloatGrid::create(0.0f);
     lit.V = openvdb::FloatGrid::create(1.0f); // outside the hair nothing blocks the light

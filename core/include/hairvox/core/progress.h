@@ -5,6 +5,10 @@
 // with the time so far and an estimate of the time left (ETA).
 // Disabled (and costing one atomic add per call) when stderr is not a terminal
 // or the user asked for quiet output.
+//
+// A caller that cannot watch stderr (the Python module's progress callback)
+// polls currentProgress() instead, from any thread: every reporter, drawn or
+// not, is listed while it lives.
 #pragma once
 
 #include <atomic>
@@ -12,6 +16,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -33,6 +38,11 @@ public:
     /// The work stops after this many seconds at the latest: the ETA never exceeds it.
     void limitTime(double seconds);
 
+    const std::string& title() const { return title_; }
+    std::uint64_t total() const { return total_; }
+    /// Work done so far, at most total().
+    std::uint64_t done() const;
+
 private:
     void draw(bool final) const;
 
@@ -47,6 +57,18 @@ private:
     std::condition_variable wake_;
     std::thread thread_;
 };
+
+/// What currentProgress() reads of a live reporter.
+struct ProgressSnapshot {
+    std::string title;
+    std::uint64_t done = 0, total = 0;
+    /// Differs between reporters created one after another (a new stage).
+    std::uint64_t serial = 0;
+};
+
+/// The most recently created ProgressReporter that has not finished, or
+/// nullopt when none is running. Thread-safe.
+std::optional<ProgressSnapshot> currentProgress();
 
 bool stderrIsTerminal();
 

@@ -162,6 +162,11 @@ struct SceneRender {
     /// concurrently); the rest is the lookups made while shading.
     double globalTermPrepareSeconds = 0;
     std::vector<std::filesystem::path> written;
+    /// What the outputs record besides the scene's (writeOutputs' `attributes`):
+    /// the fiber grid's voxel size, or a path trace's spp, seed and render
+    /// hash. Set whether or not the render wrote them, so that a caller that
+    /// writes later (the Python module's Render.save) writes the same files.
+    std::map<std::string, std::string> outputAttributes;
     std::uint64_t activeVoxels = 0; ///< of the fiber grid (0 in exact mode)
     bool gridReused = false; ///< the fiber grid splatted for the frame before (FrameReuse)
     std::uint64_t surfaceTriangles = 0; ///< of the scene's meshes

@@ -25,6 +25,7 @@
 #include <hairvox/render/rasterizer.h>
 #include <hairvox/shading/fiber_params.h>
 #include <hairvox/strands/fiber_scale.h>
+#include <hairvox/strands/groom.h>
 #include <hairvox/strands/procedural.h>
 #include <hairvox/transmittance/global_term_mode.h>
 #include <hairvox/volumetric/multiple_scattering.h>
@@ -33,6 +34,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -41,17 +43,27 @@
 
 namespace hairvox {
 
-/// Where the strands come from: a groom file or the procedural generator.
+/// Where the strands come from: a groom file, a groom in memory or the
+/// procedural generator.
 struct GroomSource {
     /// .hair/.tfx/.obj, resolved against the scene file's directory; empty → procedural.
     std::filesystem::path file;
+    /// A groom built in memory by the caller (the Python module's
+    /// hairvox.Groom) in place of a file; never read from a scene file.
+    /// loadGroom() copies and sanitizes it and resolves its attributes as a
+    /// file's (under "auto", thickness is diameters in scene units).
+    std::shared_ptr<const Groom> inMemory;
     ProceduralGroomParams procedural;
     /// How the file's per-point thickness is read (groom_attributes.h).
     GroomThickness thickness = GroomThickness::Auto;
     /// Whether the file's per-point colours set the fibers' σ_a (groom_attributes.h).
     GroomColor color = GroomColor::Use;
 
-    bool isProcedural() const { return file.empty(); }
+    bool isProcedural() const { return file.empty() && !inMemory; }
+    /// What messages and the fiber grid's metadata call the groom.
+    std::string sourceName() const {
+        return inMemory ? "in-memory groom" : file.empty() ? "procedural" : file.string();
+    }
 };
 
 /// The optional opaque head: hides the hair behind it, blocks light, and is

@@ -23,6 +23,7 @@
 #include <hairvox/voxelize/fiber_grid.h>
 
 #include <filesystem>
+#include <vector>
 
 namespace hairvox {
 
@@ -32,7 +33,19 @@ struct LitGrid {
     GlobalTermStats stats;
 };
 
+/// The global term at every active voxel of a fiber grid, in the grid's
+/// value order (FiberGrid::forEachVoxel): what the lit grids hold, packed
+/// (the Python module's numpy arrays view it).
+struct VoxelGlobalTerms {
+    std::vector<GlobalTerm> terms;
+    GlobalTermStats stats;
+};
+
 /// Evaluates `term` at every active voxel of `grid` (in parallel, deterministic).
+VoxelGlobalTerms evaluateAtActiveVoxels(const FiberGrid& grid, const LightGlobalTerm& term);
+/// The four grids of `values` (evaluateAtActiveVoxels of `grid`).
+LitGrid toLitGrid(const FiberGrid& grid, const VoxelGlobalTerms& values);
+/// Both: toLitGrid(grid, evaluateAtActiveVoxels(grid, term)).
 LitGrid evaluateOnFiberGrid(const FiberGrid& grid, const LightGlobalTerm& term);
 
 /// What a lit grid was computed from, as typed metadata: light_type (string
