@@ -282,20 +282,25 @@ constexpr std::int64_t kMaxSide = 8192;
 
 /// The keywords of render() applied to the scene, as the CLI applies its
 /// options (cli/commands/render.cpp prepareScene): one of width and height
-/// keeps the camera's aspect ratio; spp and seed belong to the path integrator.
+/// keeps the camera's aspect ratio; spp belongs to the path integrator, seed
+/// to the path and volumetric integrators.
 void applyOverrides(Scene& scene, py::handle width, py::handle height, py::handle integrator,
                     py::handle mode, py::handle spp, py::handle seed) {
     if (!mode.is_none())
         scene.globalTermMode = enumArg(mode, "mode", kGlobalTermModeNames);
     if (!integrator.is_none())
         scene.integrator = enumArg(integrator, "integrator", kIntegratorNames);
-    if ((!spp.is_none() || !seed.is_none()) && scene.integrator != Integrator::Path)
-        throw InputError(strCat("spp and seed apply to the path integrator (integrator='path'); ",
+    if (!spp.is_none() && scene.integrator != Integrator::Path)
+        throw InputError(strCat("spp applies to the path integrator (integrator='path'); ",
+                                scene.name, " uses ", toString(scene.integrator)));
+    if (!seed.is_none() && scene.integrator != Integrator::Path &&
+        scene.integrator != Integrator::Volumetric)
+        throw InputError(strCat("seed applies to the path and volumetric integrators; ",
                                 scene.name, " uses ", toString(scene.integrator)));
     if (!spp.is_none())
         scene.pathTrace.spp = std::uint32_t(intArg(spp, "spp", 1, 1'000'000));
     if (!seed.is_none())
-        scene.pathTrace.seed =
+        (scene.integrator == Integrator::Path ? scene.pathTrace.seed : scene.volumetric.seed) =
             std::uint64_t(intArg(seed, "seed", 0, std::numeric_limits<std::int64_t>::max()));
     CameraParams& camera = scene.camera;
     const double aspect = double(camera.width) / double(camera.height);
@@ -561,9 +566,10 @@ scene: None (the embedded default scene), a scene file path, a dict in the
 scene file's schema (docs/scene.md; a hairvox.Groom may stand in place of
 the groom file), or a hairvox.Groom alone (the default scene's settings).
 width, height: pixels, [1, 8192]; one alone keeps the camera's aspect ratio.
-integrator: "dual_scattering", "path", ... (the scene schema's names).
+integrator: "dual_scattering", "volumetric" or "path" (the scene schema's names).
 mode: the global-term mode, "exact", "grid" or "approx".
-spp, seed: the path integrator's samples per pixel and seed.
+spp: the path integrator's samples per pixel; seed: the path or volumetric
+integrator's seed.
 threads: worker threads (0 or None: all cores).
 progress: None, True (the CLI's bars on stderr) or a callable
 (stage, done, total), called on this thread while the render runs.
