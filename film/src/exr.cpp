@@ -406,6 +406,24 @@ ExrImage readExr(const std::filesystem::path& path) {
     }
 }
 
+ExrInfo readExrInfo(const std::filesystem::path& path) {
+    try {
+        Imf::InputFile file(path.c_str(), 1);
+        const Imf::Header& header = file.header();
+        const Imath::Box2i window = header.dataWindow();
+        ExrInfo info;
+        info.width = window.max.x - window.min.x + 1;
+        info.height = window.max.y - window.min.y + 1;
+        for (auto it = header.begin(); it != header.end(); ++it)
+            if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute()))
+                info.attributes[it.name()] = s->value();
+        info.complete = file.isComplete();
+        return info;
+    } catch (const std::exception& e) {
+        throw InputError(strCat(path.string(), ": cannot read OpenEXR file: ", e.what()));
+    }
+}
+
 Film filmFromExr(const ExrImage& image) {
     Film film(image.width, image.height);
     const auto has = [&](const std::string& name) {

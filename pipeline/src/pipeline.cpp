@@ -1,3 +1,4 @@
+#include "asset_cache.h"
 #include "dual_scattering_fragment_shader.h"
 #include "frame_reuse.h"
 #include "surfaces.h"
@@ -308,11 +309,13 @@ FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, Sc
     assets->times.load = secondsSince(start);
     throwIfInterrupted();
 
-    const std::uint64_t groom = reuse ? detail::groomKey(assets->groom.groom) : 0;
+    const DiskCache* disk = options.diskCache.get();
+    const bool keyed = reuse || disk;
+    const std::uint64_t groom = keyed ? detail::groomKey(assets->groom.groom) : 0;
     if (scene.globalTermMode != GlobalTermMode::Exact) {
         checkVoxelSizeForGroom(scene, assets->groom.groom);
         const SplatOptions splat = splatOptions(scene, options);
-        if (reuse)
+        if (keyed)
             out.gridKey = detail::gridKey(groom, splat);
         if (reuse && reuse->assets && reuse->assets->grid && reuse->gridKey == out.gridKey) {
             out.gridReused = true;
@@ -320,14 +323,16 @@ FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, Sc
             if (reuse)
                 reuse->release();
             start = Clock::now();
-            assets->grid =
-                std::make_shared<const FiberGrid>(splatStrands(assets->groom.groom, splat));
+            assets->grid = std::make_shared<const FiberGrid>(
+                disk ? detail::splatOrLoad(assets->groom.groom, splat, *disk, out.gridKey)
+                     : splatStrands(assets->groom.groom, splat));
             assets->times.voxelize = secondsSince(start);
         }
     }
-    if (reuse) {
+    if (keyed)
         out.modelKey =
             detail::modelKey(groom, out.gridKey, scene, options, assets->groom, assets->surfaces);
+    if (reuse) {
         if (reuse->assets && reuse->modelKey == out.modelKey) {
             // The same groom, surfaces, grid and model: the frame before's.
             out.reused = reuse->assets.get();
@@ -341,11 +346,14 @@ FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, Sc
     start = Clock::now();
     TableBuildOptions tableOptions;
     tableOptions.d_b = scene.dualScattering.d_b;
+    // The tables' own disk cache: given, or beside the shared grids and lights.
+    std::filesystem::path tableCacheDir = options.tableCacheDir;
+    if (tableCacheDir.empty())
+        tableCacheDir = disk ? disk->directory() : defaultTableCacheDir();
     CrossingTables crossings;
     for (const FiberParams& fiber : assets->groom.palette.fibers) {
-        assets->tables.push_back(DualScatteringTables::loadOrBuild(
-            fiber, options.tableCacheDir.empty() ? defaultTableCacheDir() : options.tableCacheDir,
-            tableOptions));
+        assets->tables.push_back(
+            DualScatteringTables::loadOrBuild(fiber, tableCacheDir, tableOptions));
         crossings.push_back(CrossingTable::fromDualScattering(assets->tables.back()));
     }
     assets->times.tables = secondsSince(start);
@@ -353,6 +361,8 @@ FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, Sc
     start = Clock::now();
     GlobalTermSettings settings = globalTermSettings(scene, assets->surfaces);
     settings.groom = &assets->groom.groom;
+    settings.diskCache = disk;
+    settings.diskCacheKey = out.modelKey;
     GridOptions gridOptions = options.grid;
     if (scene.fiberSampleSpacing)
         gridOptions.fiberSampleSpacing = *scene.fiberSampleSpacing;
@@ -525,6 +535,7 @@ SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& opti
         std::map<std::string, std::string> attributes;
         if (assets->grid)
             attributes["hairvox:voxel_size"] = std::to_string(assets->grid->info.voxelSize);
+        attributes.insert(options.outputAttributes.begin(), options.outputAttributes.end());
         result.written = writeOutputs(result.film, scene, attributes);
         result.times.write = secondsSince(start);
     }
@@ -596,10 +607,11 @@ SceneRender renderPathTraced(const Scene& scene, const PipelineOptions& options,
 
     if (writeFiles && traced.stats.spp > previousSpp) {
         start = Clock::now();
-        result.written = writeOutputs(result.film, scene,
-                                      {{"hairvox:spp", std::to_string(traced.stats.spp)},
-                                       {"hairvox:seed", std::to_string(scene.pathTrace.seed)},
-                                       {"hairvox:pathTraceHash", hash}});
+        std::map<std::string, std::string> attributes = options.outputAttributes;
+        attributes.insert({{"hairvox:spp", std::to_string(traced.stats.spp)},
+                           {"hairvox:seed", std::to_string(scene.pathTrace.seed)},
+                           {"hairvox:pathTraceHash", hash}});
+        result.written = writeOutputs(result.film, scene, attributes);
         result.times.write = secondsSince(start);
     }
     return result;

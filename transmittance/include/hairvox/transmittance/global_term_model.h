@@ -29,6 +29,8 @@
 
 namespace hairvox {
 
+class DiskCache;
+
 inline constexpr std::uint32_t kUnknownSegment = std::numeric_limits<std::uint32_t>::max();
 
 /// A point on a fiber and that fiber's unit tangent (root → tip). The strand
@@ -96,6 +98,14 @@ struct GlobalTermSettings {
     /// the fibers (GridOptions::fiberSampleSpacing). Null: every query is
     /// evaluated. Must outlive the model.
     const Groom* groom = nullptr;
+    /// Where the grid modes keep each light's prepared cache for other
+    /// processes (the render tasks of a shot, on other machines) and look for
+    /// it first, or null. Its entries are keyed by `diskCacheKey` — the
+    /// caller's digest of everything besides the light that the preparation
+    /// is made of: the fiber grid's and the crossing tables' contents, the
+    /// fiber scale and the grid options — and the light. Must outlive the model.
+    const DiskCache* diskCache = nullptr;
+    std::uint64_t diskCacheKey = 0;
 
     void validate() const;
 };

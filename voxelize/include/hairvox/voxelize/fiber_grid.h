@@ -85,6 +85,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <filesystem>
+#include <istream>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -257,5 +258,12 @@ void writeVdbFile(const std::filesystem::path& path, const openvdb::GridPtrVec& 
 /// voxels are leaf voxels). The other grids are read at the density's active
 /// voxels.
 FiberGrid readFiberGrid(const std::filesystem::path& path);
+
+/// The bytes of a .vdb file of `grid` (writeFiberGrid()'s grids as an
+/// OpenVDB stream), for a cache entry (core/disk_cache.h).
+std::string fiberGridVdbBytes(const FiberGrid& grid);
+/// readFiberGrid() from a stream of such bytes; `name` names it in messages.
+/// readFiberGrid(fiberGridVdbBytes(g)) holds g's blocks, values and info.
+FiberGrid readFiberGrid(std::istream& in, const std::string& name);
 
 } // namespace hairvox
