@@ -16,10 +16,11 @@ namespace hairvox::detail {
 inline constexpr const char* kGridCacheKind = "grid";
 
 /// The grid the cache holds under `key` (gridKey(): the groom's contents and
-/// the splat's options), or splatStrands(groom, splat) stored there. An entry
+/// the splat's options), or splatStrands(groom, splat), stored there when
+/// `store` (PipelineOptions::diskCacheStoresGrid). An entry
 /// that is not a readable fiber grid is splatted again and replaced. The
-/// grid is the same either way: readFiberGrid(fiberGridVdbBytes(g)) is g.
+/// grid is the same either way (fiberGridFromBytes(fiberGridBytes(g)) is g).
 FiberGrid splatOrLoad(const Groom& groom, const SplatOptions& splat, const DiskCache& cache,
-                      std::uint64_t key);
+                      std::uint64_t key, bool store);
 
 } // namespace hairvox::detail

@@ -324,7 +324,8 @@ FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, Sc
                 reuse->release();
             start = Clock::now();
             assets->grid = std::make_shared<const FiberGrid>(
-                disk ? detail::splatOrLoad(assets->groom.groom, splat, *disk, out.gridKey)
+                disk ? detail::splatOrLoad(assets->groom.groom, splat, *disk, out.gridKey,
+                                           options.diskCacheStoresGrid)
                      : splatStrands(assets->groom.groom, splat));
             assets->times.voxelize = secondsSince(start);
         }
@@ -363,6 +364,10 @@ FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, Sc
     settings.groom = &assets->groom.groom;
     settings.diskCache = disk;
     settings.diskCacheKey = out.modelKey;
+    if (!options.diskCacheSkipsLights.empty())
+        settings.diskCacheStores = [skip = options.diskCacheSkipsLights](const Light& light) {
+            return skip.count(light.name) == 0;
+        };
     GridOptions gridOptions = options.grid;
     if (scene.fiberSampleSpacing)
         gridOptions.fiberSampleSpacing = *scene.fiberSampleSpacing;

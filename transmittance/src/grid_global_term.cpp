@@ -288,7 +288,9 @@ public:
             rates_.emplace(std::move(rates));
         else if (workspace)
             workspace->rates.emplace(std::move(rates));
-        if (disk && cache_) // (a point light inside the volume marches: nothing to keep)
+        // (A point light inside the volume marches: nothing to keep.)
+        const auto& stores = model.settings().diskCacheStores;
+        if (disk && cache_ && (!stores || stores(light)))
             disk->store(kLightCacheKind, key, cache_->serialize());
     }
 

@@ -8,65 +8,16 @@
 // bytes from another build cannot make a lookup read out of bounds.
 #include "light_space_cache.h"
 
+#include <hairvox/core/byte_stream.h>
+
 #include <cmath>
 #include <cstring>
-#include <type_traits>
 
 namespace hairvox::detail {
 
 namespace {
 
 constexpr char kMagic[8] = {'H', 'V', 'X', 'L', 'S', 'C', '0', '1'};
-
-class Writer {
-public:
-    template <typename T>
-    requires std::is_trivially_copyable_v<T>
-    void put(const T& v) { bytes(&v, sizeof(T)); }
-    template <typename T>
-    void array(const T* data, std::size_t count) {
-        put(std::uint64_t{count});
-        bytes(data, count * sizeof(T));
-    }
-    void bytes(const void* data, std::size_t size) {
-        const std::size_t at = out.size();
-        out.resize(at + size);
-        if (size > 0)
-            std::memcpy(out.data() + at, data, size);
-    }
-    std::vector<std::byte> out;
-};
-
-class Reader {
-public:
-    explicit Reader(std::span<const std::byte> in)
-        : in_(in) {}
-    template <typename T>
-    requires std::is_trivially_copyable_v<T>
-    bool get(T& v) { return bytes(&v, sizeof(T)); }
-    /// A counted array into `v` (resized), refused if longer than what is left.
-    template <typename V>
-    bool array(V& v) {
-        std::uint64_t count = 0;
-        if (!get(count) || count > (in_.size() - at_) / sizeof(typename V::value_type))
-            return false;
-        v.resize(count);
-        return bytes(v.data(), v.size() * sizeof(typename V::value_type));
-    }
-    bool bytes(void* data, std::size_t size) {
-        if (size > in_.size() - at_)
-            return false;
-        if (size > 0)
-            std::memcpy(data, in_.data() + at_, size);
-        at_ += size;
-        return true;
-    }
-    bool atEnd() const { return at_ == in_.size(); }
-
-private:
-    std::span<const std::byte> in_;
-    std::size_t at_ = 0;
-};
 
 bool finite(const Vec3f& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
@@ -75,7 +26,7 @@ bool finite(const Vec3f& v) {
 } // namespace
 
 std::vector<std::byte> LightSpaceCache::serialize() const {
-    Writer w;
+    ByteWriter w;
     w.bytes(kMagic, sizeof(kMagic));
     w.put(static_cast<std::uint8_t>(perspective_ ? 1 : 0));
     w.put(origin_);
@@ -90,17 +41,17 @@ std::vector<std::byte> LightSpaceCache::serialize() const {
     w.put(ni_);
     w.put(nj_);
     w.put(std::uint64_t{tilesPerRow_});
-    w.array(lineRuns_.data(), lineRuns_.size());
+    w.array(std::span<const std::uint32_t>(lineRuns_.data(), lineRuns_.size()));
     w.put(std::uint64_t{tiles_.size()});
     for (const Tile& tile : tiles_) {
-        w.array(tile.runs.data(), tile.runs.size());
-        w.array(tile.samples.data(), tile.samples.size());
+        w.array(std::span<const Run>(tile.runs));
+        w.array(std::span<const Lanes>(tile.samples));
     }
     return std::move(w.out);
 }
 
 std::optional<LightSpaceCache> LightSpaceCache::deserialize(std::span<const std::byte> bytes) {
-    Reader r(bytes);
+    ByteReader r(bytes);
     char magic[sizeof(kMagic)] = {};
     LightSpaceCache c;
     std::uint8_t perspective = 0;

@@ -14,7 +14,6 @@
 #include <hairvox/voxelize/fiber_grid.h>
 
 #include <openvdb/io/File.h>
-#include <openvdb/io/Stream.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -23,7 +22,6 @@
 #include <limits>
 #include <memory>
 #include <optional>
-#include <sstream>
 
 namespace hairvox {
 
@@ -140,15 +138,13 @@ FiberGridInfo readMetadata(const openvdb::GridBase& grid, const std::string& fil
     return info;
 }
 
-/// The named grid of `grids` as GridT, null if absent; InputError if it has another type.
+/// The named grid as GridT, null if absent; InputError if it has another type
+/// or a transform other than the vertex-centred one of voxel size h.
 template <typename GridT>
-typename GridT::Ptr findGrid(const openvdb::GridPtrVec& grids, const std::string& name,
-                             const std::string& file) {
-    const auto it = std::find_if(grids.begin(), grids.end(),
-                                 [&](const auto& g) { return g && g->getName() == name; });
-    if (it == grids.end())
+typename GridT::Ptr readGrid(openvdb::io::File& in, const char* name, const std::string& file) {
+    if (!in.hasGrid(name))
         return nullptr;
-    auto grid = openvdb::gridPtrCast<GridT>(*it);
+    auto grid = openvdb::gridPtrCast<GridT>(in.readGrid(name));
     if (!grid)
         throw InputError(strCat(file, ": grid '", name, "' should be of type ", GridT::gridType()));
     return grid;
@@ -317,23 +313,26 @@ void writeVdbFile(const std::filesystem::path& path, const openvdb::GridPtrVec& 
     });
 }
 
-namespace {
-
-/// The fiber grid of the grids a .vdb file or stream holds (readFiberGrid's checks).
-FiberGrid fiberGridFromVdb(const openvdb::GridPtrVec& grids, const std::string& file) {
+FiberGrid readFiberGrid(const std::filesystem::path& path) {
+    const std::string file = path.string();
+    openvdb::initialize();
     FiberVdbGrids vdb;
     FiberGridInfo info;
     try {
-        vdb.density = findGrid<openvdb::FloatGrid>(grids, kDensityGridName, file);
-        vdb.orientation = findGrid<openvdb::Vec3SGrid>(grids, kOrientationGridName, file);
-        vdb.tensorDiag = findGrid<openvdb::Vec3SGrid>(grids, kTensorDiagGridName, file);
-        vdb.tensorOffDiag = findGrid<openvdb::Vec3SGrid>(grids, kTensorOffDiagGridName, file);
+        openvdb::io::File in(file);
+        in.open(/*delayLoad=*/false);
+        vdb.density = readGrid<openvdb::FloatGrid>(in, kDensityGridName, file);
+        vdb.orientation = readGrid<openvdb::Vec3SGrid>(in, kOrientationGridName, file);
+        vdb.tensorDiag = readGrid<openvdb::Vec3SGrid>(in, kTensorDiagGridName, file);
+        vdb.tensorOffDiag = readGrid<openvdb::Vec3SGrid>(in, kTensorOffDiagGridName, file);
         for (std::size_t t = 0; t < kMaxFiberTypes; ++t) {
-            auto fraction = findGrid<openvdb::FloatGrid>(grids, typeFractionGridName(t), file);
+            const std::string name = typeFractionGridName(t);
+            auto fraction = readGrid<openvdb::FloatGrid>(in, name.c_str(), file);
             if (!fraction)
                 break;
             vdb.typeFraction.push_back(std::move(fraction));
         }
+        in.close();
         if (!vdb.density || !vdb.orientation)
             throw InputError(strCat(file, ": a fiber grid needs the grids '", kDensityGridName,
                                     "' and '", kOrientationGridName, "'"));
@@ -373,43 +372,6 @@ FiberGrid fiberGridFromVdb(const openvdb::GridPtrVec& grids, const std::string& 
         throw InputError(strCat(file, ": cannot read as a hairvox fiber grid: ", e.what()));
     }
     return packFiberGrid(vdb, std::move(info), file);
-}
-
-} // namespace
-
-FiberGrid readFiberGrid(const std::filesystem::path& path) {
-    const std::string file = path.string();
-    openvdb::initialize();
-    openvdb::GridPtrVecPtr grids;
-    try {
-        openvdb::io::File in(file);
-        in.open(/*delayLoad=*/false);
-        grids = in.getGrids();
-        in.close();
-    } catch (const openvdb::Exception& e) {
-        throw InputError(strCat(file, ": cannot read as a hairvox fiber grid: ", e.what()));
-    }
-    return fiberGridFromVdb(*grids, file);
-}
-
-std::string fiberGridVdbBytes(const FiberGrid& grid) {
-    openvdb::initialize();
-    std::ostringstream out(std::ios::binary);
-    openvdb::io::Stream(out).write(toVdbGrids(grid).all());
-    return std::move(out).str();
-}
-
-FiberGrid readFiberGrid(std::istream& in, const std::string& name) {
-    openvdb::initialize();
-    openvdb::GridPtrVecPtr grids;
-    try {
-        grids = openvdb::io::Stream(in).getGrids();
-    } catch (const openvdb::Exception& e) {
-        throw InputError(strCat(name, ": cannot read as a hairvox fiber grid: ", e.what()));
-    }
-    if (!grids)
-        throw InputError(strCat(name, ": cannot read as a hairvox fiber grid: no grids"));
-    return fiberGridFromVdb(*grids, name);
 }
 
 } // namespace hairvox

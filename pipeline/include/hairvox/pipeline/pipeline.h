@@ -28,6 +28,7 @@
 #include <memory>
 #include <optional>
 #include <ostream>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -52,6 +53,12 @@ struct PipelineOptions {
     /// they are made of, as FrameReuse's keys) and stored there otherwise.
     /// The same bytes either way. Null: none.
     std::shared_ptr<const DiskCache> diskCache;
+    /// What the disk cache is given to keep: what other frames share. A
+    /// shot's per-frame groom makes a grid (and light preparations) of one
+    /// frame, an orbiting light a preparation of one frame: kept, they would
+    /// only fill the disk. Entries are looked for in any case.
+    bool diskCacheStoresGrid = true;
+    std::set<std::string> diskCacheSkipsLights; ///< by name
     /// String attributes added to the EXR output (a shot frame's hash).
     std::map<std::string, std::string> outputAttributes;
 };

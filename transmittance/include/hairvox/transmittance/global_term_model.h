@@ -22,6 +22,7 @@
 #include <hairvox/transmittance/global_term_mode.h>
 
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -106,6 +107,9 @@ struct GlobalTermSettings {
     /// fiber scale and the grid options — and the light. Must outlive the model.
     const DiskCache* diskCache = nullptr;
     std::uint64_t diskCacheKey = 0;
+    /// The lights whose preparation is stored there (null: every light's);
+    /// a light that moves from frame to frame is prepared for one frame only.
+    std::function<bool(const Light&)> diskCacheStores;
 
     void validate() const;
 };
