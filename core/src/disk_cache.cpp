@@ -191,6 +191,12 @@ bool DiskCache::store(std::string_view kind, std::uint64_t key,
     return true;
 }
 
+void DiskCache::discard(std::string_view kind, std::uint64_t key) const {
+    corrupt_.fetch_add(1, std::memory_order_relaxed);
+    std::error_code ec;
+    fs::remove(entryPath(kind, key), ec);
+}
+
 DiskCache::Stats DiskCache::stats() const {
     Stats s;
     s.hits = hits_.load();

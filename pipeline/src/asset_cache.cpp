@@ -15,6 +15,7 @@ FiberGrid splatOrLoad(const Groom& groom, const SplatOptions& splat, const DiskC
             return fiberGridFromBytes(*bytes, name);
         } catch (const InputError& e) {
             std::cerr << "hairvox: warning: cache entry " << e.what() << "; splatted again\n";
+            cache.discard(kGridCacheKind, key);
         }
     }
     FiberGrid grid = splatStrands(groom, splat);

@@ -99,10 +99,11 @@ Orbit parseOrbit(const json& v, const std::string& source, const std::string& pa
     return orbit;
 }
 
-/// The file name of `value` (a JSON string) for frame f, or the value as it is.
-void expandIn(json& object, const char* key, int frame, const std::string& path) {
+/// object[key] (a file name) for frame f; `where` prefixes messages ("shot.json: /output").
+void expandIn(json& object, const char* key, int frame, const std::string& where) {
     if (object.is_object() && object.contains(key) && object[key].is_string())
-        object[key] = expandFramePattern(object[key].get<std::string>(), frame, path + "/" + key);
+        object[key] =
+            expandFramePattern(object[key].get<std::string>(), frame, strCat(where, "/", key));
 }
 
 bool hasPattern(const json& object, const char* key) {
@@ -213,6 +214,9 @@ Shot Shot::parse(const json& document, const std::string& sourceName,
         for (const char* key : {"exr", "png"}) {
             if (!output.contains(key))
                 output[key] = strCat("out/", stem.empty() ? "shot" : stem, ".####.", key);
+            if (output[key].is_string()) // a malformed pattern says so first
+                expandFramePattern(output[key].get<std::string>(), shot.start_,
+                                   strCat(sourceName, ": /output/", key));
             if (output[key].is_string() && shot.end_ > shot.start_ && !hasPattern(output, key))
                 fail(sourceName, strCat("/output/", key),
                      strCat("\"", output[key].get<std::string>(),
@@ -225,8 +229,9 @@ Shot Shot::parse(const json& document, const std::string& sourceName,
         for (const json& mesh : scene["meshes"])
             shot.meshesVary_ = shot.meshesVary_ || hasPattern(mesh, "file");
     shot.scene_ = std::make_shared<const json>(std::move(scene));
-    // Every scene key is checked now (and each frame's own values when it is made).
-    (void)shot.frame(shot.start_);
+    // Every scene key is checked now, in the shot's name (each frame's own
+    // values when it is made, in the frame's).
+    (void)shot.makeFrame(shot.start_, sourceName);
     return shot;
 }
 
@@ -263,17 +268,20 @@ FrameSet Shot::select(const FrameSet& frames, std::string_view what) const {
 }
 
 Scene Shot::frame(int f) const {
-    const std::string name = strCat(name_, " frame ", f);
+    return makeFrame(f, strCat(name_, " frame ", f));
+}
+
+Scene Shot::makeFrame(int f, const std::string& name) const {
     json document = *scene_;
     // Frame numbers into the file names.
     if (document.contains("groom"))
-        expandIn(document["groom"], "file", f, "/groom");
+        expandIn(document["groom"], "file", f, name + ": /groom");
     if (document.contains("meshes") && document["meshes"].is_array())
         for (std::size_t i = 0; i < document["meshes"].size(); ++i)
-            expandIn(document["meshes"][i], "file", f, strCat("/meshes/", i));
+            expandIn(document["meshes"][i], "file", f, strCat(name, ": /meshes/", i));
     if (document.contains("output")) {
-        expandIn(document["output"], "exr", f, "/output");
-        expandIn(document["output"], "png", f, "/output");
+        expandIn(document["output"], "exr", f, name + ": /output");
+        expandIn(document["output"], "png", f, name + ": /output");
     }
     Scene scene = parseScene(document, name, baseDir_);
     // The orbits turn the camera rig and the lights.

@@ -272,6 +272,7 @@ public:
                 std::cerr << "hairvox: warning: cache entry "
                           << disk->entryPath(kLightCacheKind, key).string()
                           << " is not a light-space cache of this build; computed again\n";
+                disk->discard(kLightCacheKind, key);
             }
         }
         BrickVolume rates =

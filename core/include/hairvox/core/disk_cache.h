@@ -52,6 +52,11 @@ public:
     /// the next process will compute it again.
     bool store(std::string_view kind, std::uint64_t key, std::span<const std::byte> payload) const;
 
+    /// Removes the entry of (kind, key): its payload was intact but the
+    /// caller could not use it (bytes of another build). The next store()
+    /// writes it again.
+    void discard(std::string_view kind, std::uint64_t key) const;
+
     /// The file of (kind, key).
     std::filesystem::path entryPath(std::string_view kind, std::uint64_t key) const;
 

@@ -89,6 +89,9 @@ public:
     Scene frame(int f) const;
 
 private:
+    /// frame(f) named `name` in its messages and report.
+    Scene makeFrame(int f, const std::string& name) const;
+
     std::string name_;
     std::filesystem::path baseDir_;
     int start_ = 1, end_ = 1;
