@@ -76,7 +76,7 @@ void runSubmit(const SubmitCommandOptions& opt) {
     options.memory = opt.memory;
     options.force = opt.force;
     options.sheet = opt.sheet;
-    const shots::FarmJob job = shots::makeFarmJob(options, frames);
+    const shots::FarmJob job = shots::makeFarmJob(options, frames, asked);
     shots::writeFarmJob(job);
     const std::string summary = strCat(
         "frames ", frames.toString(), " of ", opt.shot, " (", frames.size(), " of ", asked.size(),

@@ -39,7 +39,7 @@ void SubmitOptions::validate() const {
             throw std::invalid_argument(strCat("SubmitOptions: ", p->string(), " is not absolute"));
 }
 
-FarmJob makeFarmJob(const SubmitOptions& o, const FrameSet& frames) {
+FarmJob makeFarmJob(const SubmitOptions& o, const FrameSet& frames, const FrameSet& shown) {
     o.validate();
     if (frames.empty())
         throw std::invalid_argument("makeFarmJob: no frames");
@@ -103,7 +103,7 @@ FarmJob makeFarmJob(const SubmitOptions& o, const FrameSet& frames) {
             t += strCat("#SBATCH --partition=", o.partition, "\n");
         t += "set -euo pipefail\n";
         t += strCat("exec ", shellQuoted(o.hairvox.string()), " sheet ", quotedShot, " --frames ",
-                    shellQuoted(frames.toString()), "\n");
+                    shellQuoted(shown.toString()), "\n");
         job.sheetText = std::move(t);
     }
     return job;

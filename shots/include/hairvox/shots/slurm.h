@@ -47,8 +47,10 @@ struct FarmJob {
     std::filesystem::path logDir;
 };
 
-/// The job that renders `frames` (SubmitOptions validated; frames not empty).
-FarmJob makeFarmJob(const SubmitOptions& options, const FrameSet& frames);
+/// The job that renders `frames` (SubmitOptions validated; frames not
+/// empty), and whose sheet job (SubmitOptions::sheet) shows `shown`: the
+/// frames asked for, done before or not.
+FarmJob makeFarmJob(const SubmitOptions& options, const FrameSet& frames, const FrameSet& shown);
 
 /// Writes the scripts (atomically, executable) and creates the log directory.
 void writeFarmJob(const FarmJob& job);
