@@ -4,6 +4,7 @@
 //                [--spp N]
 //                [--time-limit S] [--seed S] [--continue] [--width W] [--height H]
 //                [--voxel-size V] [--max-memory GIB] [--threads N] [--quiet]
+//                [--frames F] [--force] [--cache DIR]
 // Renders a scene (or the embedded default scene) to EXR + PNG and prints the
 // time per stage. Outputs given on the command line replace the scene's
 // (exactly those are written); two outputs never go to the same file, nor over
@@ -18,6 +19,11 @@
 // the batch. Each scene writes the outputs its JSON names. A frame takes the
 // fiber grid and the lights' preparation from the frame before where what
 // they are made of is unchanged (FrameReuse, pipeline/pipeline.h).
+//
+// hairvox render SHOT.json [--frames F] [--force] [--cache DIR]: a shot's
+// frames (a scene with "frames"; shots/shot_render.h, docs/farm.md), a line
+// per frame, skipping the frames done unless --force. --cache DIR shares the
+// fiber grid and the lights' preparation with other processes (a farm's tasks).
 #include "../commands.h"
 
 #include <hairvox/core/error.h>

@@ -186,5 +186,16 @@ TEST(ShotsShot, IsShotFileTellsShotsFromScenes) {
     EXPECT_EQ(Shot::load(dir / "shot.json").name(), (dir / "shot.json").string());
 }
 
+TEST(ShotsShot, ExampleShotsParse) {
+    int count = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(test::dataDir() / "shots")) {
+        SCOPED_TRACE(entry.path().string());
+        const Shot shot = Shot::load(entry.path());
+        EXPECT_NO_THROW(shot.frame(shot.end()));
+        ++count;
+    }
+    EXPECT_GE(count, 1);
+}
+
 } // namespace
 } // namespace hairvox::shots
