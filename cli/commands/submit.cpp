@@ -1,5 +1,6 @@
 // hairvox submit SHOT.json [--frames F] [--per-task N] [--partition P] [--time T]
-//                [--cpus N] [--mem M] [--cache DIR] [--sheet] [--force] [--dry-run]
+//                [--cpus N] [--mem M] [--max-running N] [--sbatch=OPTION ...]
+//                [--cache DIR] [--sheet] [--force] [--dry-run]
 // Renders a shot on a Slurm cluster: the frames not done (hairvox status) in
 // array tasks of --per-task frames (shots/slurm.h), submitted with sbatch.
 #include "../commands.h"
@@ -22,7 +23,8 @@ namespace fs = std::filesystem;
 
 struct SubmitCommandOptions {
     std::string shot, frames, partition, time, memory, cacheDir, hairvox;
-    std::size_t perTask = 8;
+    std::size_t perTask = 8, maxRunning = 0;
+    std::vector<std::string> sbatch;
     int cpus = 0;
     bool sheet = false, force = false, dryRun = false;
 };
@@ -74,6 +76,8 @@ void runSubmit(const SubmitCommandOptions& opt) {
     options.partition = opt.partition;
     options.timeLimit = opt.time;
     options.memory = opt.memory;
+    options.maxRunning = opt.maxRunning;
+    options.sbatchOptions = opt.sbatch;
     options.force = opt.force;
     options.sheet = opt.sheet;
     const shots::FarmJob job = shots::makeFarmJob(options, frames, asked);
@@ -129,6 +133,13 @@ void addSubmitCommand(CLI::App& app) {
                     "CPUs per task, the render's threads (default: this machine's CPUs)")
         ->check(CLI::Range(1, 4096));
     cmd->add_option("--mem", opt->memory, "Memory per task, e.g. 8G (default: the partition's)");
+    cmd->add_option("--max-running", opt->maxRunning,
+                    "Tasks running at once at most (Slurm's --array=...%N; default: no limit)")
+        ->check(CLI::Range(std::size_t(1), std::size_t(100000)));
+    cmd->add_option("--sbatch", opt->sbatch,
+                    "One more sbatch option for the job's script, e.g. --sbatch=--account=show "
+                    "--sbatch=--qos=low (repeatable)")
+        ->allow_extra_args(false);
     cmd->add_option("--cache", opt->cacheDir,
                     "Shared cache directory on a file system every node sees (default: "
                     "<shot>.farm/cache beside the shot)");

@@ -34,6 +34,11 @@ void SubmitOptions::validate() const {
     static const std::regex mem(R"(^\d+[KMGT]?$)");
     if (!memory.empty() && !std::regex_match(memory, mem))
         throw InputError(strCat("--mem ", memory, ": expected Slurm's form, e.g. 8G or 8000M"));
+    for (const std::string& option : sbatchOptions)
+        if (option.size() < 2 || option[0] != '-' ||
+            option.find_first_of("\n\r") != std::string::npos)
+            throw InputError(
+                strCat("--sbatch '", option, "': expected one sbatch option, e.g. --account=show"));
     for (const fs::path* p : {&shotFile, &workDir, &farmDir, &cacheDir, &hairvox})
         if (!p->is_absolute())
             throw std::invalid_argument(strCat("SubmitOptions: ", p->string(), " is not absolute"));
@@ -58,7 +63,8 @@ FarmJob makeFarmJob(const SubmitOptions& o, const FrameSet& frames, const FrameS
     s += "# Each task renders its chunk of frames; a frame already done (its EXR\n"
          "# records this frame's digest) is skipped, so resubmitting is safe.\n";
     s += strCat("#SBATCH --job-name=", shellQuoted(strCat("hairvox-", stem)), "\n");
-    s += strCat("#SBATCH --array=0-", job.chunks.size() - 1, "\n");
+    s += strCat("#SBATCH --array=0-", job.chunks.size() - 1,
+                o.maxRunning > 0 ? strCat("%", o.maxRunning) : std::string(), "\n");
     s += strCat("#SBATCH --cpus-per-task=", o.cpus, "\n");
     s += "#SBATCH --ntasks=1\n";
     s += strCat("#SBATCH --chdir=", o.workDir.string(), "\n");
@@ -70,6 +76,8 @@ FarmJob makeFarmJob(const SubmitOptions& o, const FrameSet& frames, const FrameS
         s += strCat("#SBATCH --time=", o.timeLimit, "\n");
     if (!o.memory.empty())
         s += strCat("#SBATCH --mem=", o.memory, "\n");
+    for (const std::string& option : o.sbatchOptions)
+        s += strCat("#SBATCH ", option, "\n");
     s += "set -euo pipefail\n";
     s += "chunks=(";
     for (const FrameSet& c : job.chunks)
@@ -101,6 +109,8 @@ FarmJob makeFarmJob(const SubmitOptions& o, const FrameSet& frames, const FrameS
         t += strCat("#SBATCH --error=", (job.logDir / (stem + "-sheet-%j.err")).string(), "\n");
         if (!o.partition.empty())
             t += strCat("#SBATCH --partition=", o.partition, "\n");
+        for (const std::string& option : o.sbatchOptions)
+            t += strCat("#SBATCH ", option, "\n");
         t += "set -euo pipefail\n";
         t += strCat("exec ", shellQuoted(o.hairvox.string()), " sheet ", quotedShot, " --frames ",
                     shellQuoted(shown.toString()), "\n");

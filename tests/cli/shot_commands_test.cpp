@@ -128,12 +128,14 @@ TEST(CliShots, SubmitDryRunWritesTheScriptOfTheFramesNotDone) {
               0);
     const auto dry = test::runHairvox("submit " + quoted(shot) +
                                       " --per-task 2 --cpus 3 --partition gpu_a --time 1:00:00 "
-                                      "--mem 4G --sheet --dry-run");
+                                      "--mem 4G --max-running 5 --sbatch=--account=show "
+                                      "--sbatch=--qos=low --sheet --dry-run");
     ASSERT_EQ(dry.exitCode, 0) << dry.output;
     EXPECT_TRUE(contains(dry.output, "dry run, nothing submitted: frames 1,3-4")) << dry.output;
     const std::string script = test::readBytes(dir / "turn.farm/turn.sbatch");
     EXPECT_TRUE(contains(dry.output, script));
-    EXPECT_TRUE(contains(script, "#SBATCH --array=0-1\n")) << script;
+    EXPECT_TRUE(contains(script, "#SBATCH --array=0-1%5\n")) << script;
+    EXPECT_TRUE(contains(script, "#SBATCH --account=show\n#SBATCH --qos=low\n")) << script;
     EXPECT_TRUE(contains(script, "#SBATCH --cpus-per-task=3\n")) << script;
     EXPECT_TRUE(contains(script, "#SBATCH --partition=gpu_a\n")) << script;
     EXPECT_TRUE(contains(script, "#SBATCH --time=1:00:00\n")) << script;
@@ -153,6 +155,10 @@ TEST(CliShots, SubmitDryRunWritesTheScriptOfTheFramesNotDone) {
     const auto badTime = test::runHairvox("submit " + quoted(shot) + " --time soon --dry-run");
     EXPECT_EQ(badTime.exitCode, 2);
     EXPECT_TRUE(contains(badTime.output, "--time soon")) << badTime.output;
+    const auto badOption =
+        test::runHairvox("submit " + quoted(shot) + " --sbatch=account --dry-run");
+    EXPECT_EQ(badOption.exitCode, 2);
+    EXPECT_TRUE(contains(badOption.output, "expected one sbatch option")) << badOption.output;
     const auto noSbatch = test::runShell("PATH=/nonexistent " + quoted(HAIRVOX_BINARY) +
                                          " submit " + quoted(shot) + " 2>&1");
     EXPECT_EQ(noSbatch.exitCode, 2) << noSbatch.output;

@@ -29,8 +29,12 @@ struct SubmitOptions {
     std::string partition;          ///< empty: the cluster's default
     std::string timeLimit;          ///< per task, Slurm's [days-]HH:MM:SS; empty: the partition's
     std::string memory;             ///< per task, e.g. "8G"; empty: the partition's default
-    bool force = false;             ///< tasks render frames that are done too
-    bool sheet = false;             ///< a dependent job that runs hairvox sheet
+    std::size_t maxRunning = 0;     ///< tasks running at once (--array=...%N); 0: no limit
+    /// More sbatch options, each an #SBATCH line: "--account=show",
+    /// "--qos=low", "--exclude=node07" (each starts with '-', one line).
+    std::vector<std::string> sbatchOptions;
+    bool force = false;                  ///< tasks render frames that are done too
+    bool sheet = false;                  ///< a dependent job that runs hairvox sheet
     std::vector<std::string> renderArgs; ///< more arguments of every task's render
 
     /// InputError naming the option and its valid form.
