@@ -3,8 +3,8 @@
 // — by ctest's fixture (tests/CMakeLists.txt: HAIRVOX_SLURM_DIR) or, when
 // this binary runs alone, by the suite itself. If the cluster cannot start or
 // does not answer, every test here FAILS with the reason.
-//   - an 8-frame turntable as an array of 4 tasks lands the local render's
-//     pixels, and the dependent sheet job makes the movie;
+//   - an 8-frame turntable as an array of 4 tasks (2 running at once) lands
+//     the local render's pixels, and the dependent sheet job makes the movie;
 //   - a task cancelled mid-frame leaves no partial file under any name, and
 //     the resubmission renders only the frames it did not finish;
 //   - two tasks that start together write one cache without corrupting it.
@@ -198,13 +198,14 @@ TEST_F(SlurmFarm, ATurntableAsFourTasksIsTheLocalRenderPixelForPixel) {
     const double localSeconds = std::chrono::duration<double>(Clock::now() - start).count();
 
     const auto submitted = Clock::now();
-    const std::string id = submit(farm, "--per-task 2 --cpus 1 --sheet");
+    const std::string id = submit(farm, "--per-task 2 --cpus 1 --max-running 2 --sheet");
     ASSERT_FALSE(id.empty());
     const std::vector<std::string> states = waitForJob(id);
     const double farmSeconds = std::chrono::duration<double>(Clock::now() - submitted).count();
     EXPECT_EQ(states, std::vector<std::string>(4, "COMPLETED")) << taskLogs("farm", id);
     const std::string logs = taskLogs("farm", id);
     EXPECT_EQ(count(logs, "2 of 2 frames rendered"), 4u) << logs;
+    // Two tasks at a time (--max-running 2): the second pair reads what the first cached.
     EXPECT_GE(count(logs, " read,"), 1u) << "no task read what another cached:\n" << logs;
 
     for (int f = 1; f <= 8; ++f) {
