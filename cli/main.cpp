@@ -24,6 +24,9 @@ int main(int argc, char** argv) {
     hairvox::cli::addInfoCommand(app);
     hairvox::cli::addProbeCommand(app);
     hairvox::cli::addRenderCommand(app);
+    hairvox::cli::addSheetCommand(app);
+    hairvox::cli::addStatusCommand(app);
+    hairvox::cli::addSubmitCommand(app);
     hairvox::cli::addTablesCommand(app);
     hairvox::cli::addTransmittanceCommand(app);
     hairvox::cli::addVoxelizeCommand(app);

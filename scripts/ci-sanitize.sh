@@ -7,7 +7,7 @@
 # Sanitizer + UndefinedBehaviorSanitizer (every report is fatal) and the
 # libFuzzer targets of fuzz/:
 #   tests  the fast tests (ctest -L fast) under the sanitizers;
-#   fuzz   each fuzzer (hair, tfx, obj, mesh, scene) for HAIRVOX_FUZZ_SECONDS (default
+#   fuzz   each fuzzer (hair, tfx, obj, mesh, scene, shot) for HAIRVOX_FUZZ_SECONDS (default
 #          60) from its committed seed corpus fuzz/corpus/<target>/, two at a
 #          time; new corpus entries go to a temporary directory, crashing inputs
 #          to <build>/fuzz-findings/.
@@ -21,7 +21,7 @@ what=${1:-all}
 case "$what" in all|tests|fuzz) ;; *) echo "ci-sanitize.sh: unknown job '$what' (all, tests, fuzz)" >&2; exit 2 ;; esac
 jobs=${HAIRVOX_JOBS:-2}
 build=${HAIRVOX_SANITIZE_DIR:-build/sanitize}
-fuzzers=(hair tfx obj mesh scene)
+fuzzers=(hair tfx obj mesh scene shot)
 
 stamp() { printf '%s: %s (%d:%02d elapsed)\n' "ci-sanitize" "$1" $((SECONDS / 60)) $((SECONDS % 60)); }
 

@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
 # Installs hairvox's dependencies from Debian 12 packages. Idempotent: apt-get
 # runs (update once, then install) only when a package is missing.
+# slurm-wlm and munge: the farm tests' one-node cluster (scripts/slurm-cluster.sh
+# starts private daemons; the packages' own services are not used); ffmpeg:
+# `hairvox sheet`'s movies and contact sheets.
 set -euo pipefail
 
 packages=(
@@ -14,6 +17,7 @@ packages=(
   clang libclang-rt-14-dev
   python3-numpy python3-matplotlib
   python3-dev pybind11-dev libboost-python1.74-dev python3-pytest
+  slurm-wlm munge ffmpeg
 )
 
 missing=()

@@ -4,6 +4,7 @@
 //                [--spp N] [--paths N]
 //                [--time-limit S] [--seed S] [--continue] [--width W] [--height H]
 //                [--voxel-size V] [--max-memory GIB] [--threads N] [--quiet]
+//                [--frames F] [--force] [--cache DIR]
 // Renders a scene (or the embedded default scene) to EXR + PNG and prints the
 // time per stage. Outputs given on the command line replace the scene's
 // (exactly those are written); two outputs never go to the same file, nor over
@@ -18,11 +19,19 @@
 // the batch. Each scene writes the outputs its JSON names. A frame takes the
 // fiber grid and the lights' preparation from the frame before where what
 // they are made of is unchanged (FrameReuse, pipeline/pipeline.h).
+//
+// hairvox render SHOT.json [--frames F] [--force] [--cache DIR]: a shot's
+// frames (a scene with "frames"; shots/shot_render.h, docs/farm.md), a line
+// per frame, skipping the frames done unless --force. --cache DIR shares the
+// fiber grid and the lights' preparation with other processes (a farm's tasks).
 #include "../commands.h"
 
 #include <hairvox/core/error.h>
 #include <hairvox/core/progress.h>
 #include <hairvox/pipeline/pipeline.h>
+#include <hairvox/shots/frame_set.h>
+#include <hairvox/shots/shot.h>
+#include <hairvox/shots/shot_render.h>
 
 #include <algorithm>
 #include <cctype>
@@ -55,6 +64,9 @@ struct RenderCommandOptions {
     std::optional<double> maxMemoryGiB;
     int threads = 0;
     bool quiet = false;
+    std::string frames;   ///< a shot's frames (shots/frame_set.h); empty: all
+    bool force = false;   ///< a shot's frames that are done rendered again
+    std::string cacheDir; ///< the shared disk cache (PipelineOptions::diskCache)
 };
 
 /// Two paths naming the same file (textually, or the same existing file).
@@ -145,10 +157,8 @@ void resolveResolution(const RenderCommandOptions& opt, CameraParams& camera) {
                                 kMaxResolution, " pixels a side; give both --width and --height"));
 }
 
-/// The scene at `path` (empty: the embedded default scene) with the command
-/// line's choices applied, checked.
-Scene prepareScene(const RenderCommandOptions& opt, const std::string& path) {
-    Scene scene = path.empty() ? defaultScene() : loadScene(path);
+/// The command line's choices applied to a scene read from `path`, checked.
+void applyOverrides(const RenderCommandOptions& opt, const std::string& path, Scene& scene) {
     if (!opt.mode.empty())
         scene.globalTermMode = *kGlobalTermModeNames.parse(opt.mode); // CLI11 checked the choice
     if (!opt.integrator.empty())
@@ -203,6 +213,13 @@ Scene prepareScene(const RenderCommandOptions& opt, const std::string& path) {
         scene.voxelSize = *opt.voxelSize;
     resolveOutputs(opt, path, scene);
     scene.validate();
+}
+
+/// The scene at `path` (empty: the embedded default scene) with the command
+/// line's choices applied, checked.
+Scene prepareScene(const RenderCommandOptions& opt, const std::string& path) {
+    Scene scene = path.empty() ? defaultScene() : loadScene(path);
+    applyOverrides(opt, path, scene);
     return scene;
 }
 
@@ -214,6 +231,8 @@ PipelineOptions pipelineOptions(const RenderCommandOptions& opt) {
     options.threads = opt.threads;
     options.progress = !opt.quiet && stderrIsTerminal();
     options.continuePathTrace = opt.continueRun;
+    if (!opt.cacheDir.empty())
+        options.diskCache = std::make_shared<const DiskCache>(opt.cacheDir);
     return options;
 }
 
@@ -231,6 +250,49 @@ void renderOne(const RenderCommandOptions& opt, const Scene& scene, FrameReuse* 
             strCat("interrupted after ", render.pathTrace->spp, " samples per pixel; ",
                    render.written.empty() ? "no output was written"
                                           : "the image holds them (add samples with --continue)"));
+}
+
+/// One line per frame of a shot (and the render's report unless --quiet).
+void printFrameReport(std::ostream& os, const RenderCommandOptions& opt,
+                      const shots::FrameReport& r) {
+    char line[256];
+    const char* what = r.outcome == shots::FrameReport::Outcome::Rendered   ? "rendered"
+                       : r.outcome == shots::FrameReport::Outcome::UpToDate ? "up to date"
+                                                                            : "FAILED";
+    std::snprintf(line, sizeof(line), "frame %d (%zu of %zu): %s in %.2f s", r.frame, r.index,
+                  r.count, what, r.seconds);
+    os << line;
+    if (r.render) {
+        std::size_t reusedLights = 0;
+        for (const LightReport& l : r.render->lights)
+            reusedLights += l.reused ? 1 : 0;
+        if (r.render->gridReused || reusedLights > 0)
+            os << "; the frame before's " << (r.render->gridReused ? "grid" : "")
+               << (r.render->gridReused && reusedLights > 0 ? " and " : "")
+               << (reusedLights > 0 ? strCat(reusedLights, " light(s)") : std::string());
+    }
+    if (r.cache.hits + r.cache.stored > 0)
+        os << "; cache: " << r.cache.hits << " read, " << r.cache.stored << " written";
+    if (r.cache.corrupt > 0)
+        os << ", " << r.cache.corrupt << " corrupt entr" << (r.cache.corrupt == 1 ? "y" : "ies")
+           << " rebuilt";
+    if (r.outcome == shots::FrameReport::Outcome::UpToDate)
+        os << " ("
+           << (r.scene->output.exr.empty() ? r.scene->output.png : r.scene->output.exr).string()
+           << " records this frame's digest)";
+    os << "\n";
+    if (r.outcome == shots::FrameReport::Outcome::Failed)
+        std::cerr << "hairvox: " << (r.internalError ? "internal error: " : "error: ") << "frame "
+                  << r.frame << ": " << r.error << "\n";
+    if (r.render) {
+        for (const std::string& warning : r.render->warnings)
+            std::cerr << "hairvox: warning: frame " << r.frame << ": " << warning << "\n";
+        if (!opt.quiet)
+            printTimingReport(os, *r.scene, *r.render);
+        for (const auto& path : r.render->written)
+            os << "wrote " << path.string() << "\n";
+    }
+    os << std::flush;
 }
 
 /// What identifies a file across spellings: device and inode where it
@@ -268,7 +330,57 @@ void checkBatchFiles(const std::vector<std::string>& paths, const std::vector<Sc
         }
 }
 
+/// A shot's frames (shot_render.h), each line saying what became of it.
+void runShot(const RenderCommandOptions& opt) {
+    if (opt.scenes.size() != 1)
+        throw InputError(strCat("--frames renders the frames of one shot; ", opt.scenes.size(),
+                                " scene files given"));
+    if (!opt.output.empty() || !opt.exr.empty() || !opt.png.empty())
+        throw InputError("a shot writes the outputs its frames name (output.exr and output.png "
+                         "with a frame number); --exr, --png and -o name one file");
+    if (opt.continueRun)
+        throw InputError("--continue applies to one path-traced scene, not to a shot's frames");
+    const std::string& path = opt.scenes[0];
+    const shots::Shot shot = shots::Shot::load(path);
+    const shots::FrameSet frames =
+        opt.frames.empty() ? shot.frames() : shot.select(shots::FrameSet::parse(opt.frames));
+    shots::ShotRenderOptions options;
+    options.pipeline = pipelineOptions(opt);
+    options.force = opt.force;
+    options.adjust = [&](Scene& scene) {
+        applyOverrides(opt, path, scene);
+    };
+    std::cout << "hairvox: " << path << ": " << frames.size() << " frame(s) " << frames.toString()
+              << " of " << shot.start() << "-" << shot.end() << "\n"
+              << std::flush;
+    const shots::ShotRenderSummary summary =
+        shots::renderShot(shot, frames, options, [&](const shots::FrameReport& r) {
+            printFrameReport(std::cout, opt, r);
+        });
+    char line[200];
+    std::snprintf(line, sizeof(line),
+                  "hairvox: %zu of %zu frames rendered, %zu up to date, %zu failed in %.2f s "
+                  "(%.2f s a rendered frame)\n",
+                  summary.rendered, frames.size(), summary.upToDate, summary.failed.size(),
+                  summary.seconds,
+                  summary.rendered > 0 ? summary.seconds / double(summary.rendered) : 0.0);
+    std::cout << line << std::flush;
+    if (summary.failed.empty())
+        return;
+    const std::string message = strCat(summary.failed.size(), " of ", frames.size(),
+                                       " frames failed: ", summary.failed.toString());
+    if (summary.internalError)
+        throw std::runtime_error(message);
+    throw InputError(message);
+}
+
 void runRender(const RenderCommandOptions& opt) {
+    if (!opt.frames.empty() || (opt.scenes.size() == 1 && shots::isShotFile(opt.scenes[0]))) {
+        runShot(opt);
+        return;
+    }
+    if (opt.force)
+        throw InputError("--force applies to a shot's frames (a scene with \"frames\")");
     if (opt.scenes.size() <= 1) {
         renderOne(opt, prepareScene(opt, opt.scenes.empty() ? std::string() : opt.scenes[0]));
         return;
@@ -407,6 +519,13 @@ void addRenderCommand(CLI::App& app) {
         ->check(CLI::PositiveNumber);
     cmd->add_option("--threads", opt->threads, "Worker threads (0: all cores)")
         ->check(CLI::Range(0, 1024));
+    cmd->add_option("--frames", opt->frames,
+                    "A shot's frames to render: 1-240, 1-240x2 (every other), 7, or lists "
+                    "1-10,20; default: all. Frames already done are skipped (docs/farm.md)");
+    cmd->add_flag("--force", opt->force, "Shot: render the frames that are done too");
+    cmd->add_option("--cache", opt->cacheDir,
+                    "Directory of fiber grids, lights' preparations and tables shared by "
+                    "renders on many machines (a farm's tasks; docs/farm.md)");
     cmd->add_flag("--quiet", opt->quiet, "No progress bar and no timing report");
     cmd->callback([opt] { runRender(*opt); });
 }

@@ -2,9 +2,11 @@
 #include <hairvox/core/error.h>
 
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <fcntl.h>
+#include <string>
 #include <unistd.h>
 
 namespace hairvox {
@@ -13,10 +15,27 @@ namespace fs = std::filesystem;
 
 namespace {
 
+/// This machine's name as a temporary name may hold it: letters, digits,
+/// '-' and '.' (anything else '_'); "host" if it has none.
+std::string hostTag() {
+    char name[256] = {};
+    if (::gethostname(name, sizeof(name) - 1) != 0 || name[0] == '\0')
+        return "host";
+    std::string tag(name);
+    for (char& c : tag)
+        if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '.')
+            c = '_';
+    return tag;
+}
+
+/// Unique among the processes of every machine that share the directory (a
+/// render farm's tasks on a network file system): process ids repeat across
+/// machines, so the host name is part of it.
 fs::path temporaryPathFor(const fs::path& finalPath) {
     static std::atomic<unsigned> counter{0};
-    const fs::path name = strCat(".", finalPath.filename().string(), ".tmp-", ::getpid(), "-",
-                                 counter.fetch_add(1));
+    static const std::string host = hostTag();
+    const fs::path name =
+        strCat(temporaryPrefix(finalPath), host, "-", ::getpid(), "-", counter.fetch_add(1));
     return finalPath.parent_path() / name;
 }
 
@@ -33,6 +52,10 @@ void syncFile(const fs::path& path) {
 }
 
 } // namespace
+
+std::string temporaryPrefix(const fs::path& finalPath) {
+    return strCat(".", finalPath.filename().string(), ".tmp-");
+}
 
 void writeFileAtomically(const fs::path& finalPath,
                          const std::function<void(const fs::path& tmpPath)>& write) {

@@ -406,6 +406,56 @@ ExrImage readExr(const std::filesystem::path& path) {
     }
 }
 
+namespace {
+
+/// Whether every chunk of a scanline file lies within the file: OpenEXR's
+/// isComplete() trusts the offset table, which a file cut short keeps.
+bool chunksInFile(const std::filesystem::path& path) {
+    std::error_code ec;
+    const std::uintmax_t size = std::filesystem::file_size(path, ec);
+    if (ec)
+        return false;
+    exr_context_t ctx = nullptr;
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.error_handler_fn = [](exr_const_context_t, exr_result_t, const char*) {
+    };
+    if (exr_start_read(&ctx, path.c_str(), &init) != EXR_ERR_SUCCESS)
+        return false;
+    bool inside = true;
+    int32_t lines = 0;
+    exr_attr_box2i_t window{};
+    if (exr_get_scanlines_per_chunk(ctx, 0, &lines) != EXR_ERR_SUCCESS || lines < 1 ||
+        exr_get_data_window(ctx, 0, &window) != EXR_ERR_SUCCESS)
+        inside = false;
+    for (int y = window.min.y; inside && y <= window.max.y; y += lines) {
+        exr_chunk_info_t chunk{};
+        inside = exr_read_scanline_chunk_info(ctx, 0, y, &chunk) == EXR_ERR_SUCCESS &&
+                 chunk.data_offset + chunk.packed_size <= size;
+    }
+    exr_finish(&ctx);
+    return inside;
+}
+
+} // namespace
+
+ExrInfo readExrInfo(const std::filesystem::path& path) {
+    try {
+        Imf::InputFile file(path.c_str(), 1);
+        const Imf::Header& header = file.header();
+        const Imath::Box2i window = header.dataWindow();
+        ExrInfo info;
+        info.width = window.max.x - window.min.x + 1;
+        info.height = window.max.y - window.min.y + 1;
+        for (auto it = header.begin(); it != header.end(); ++it)
+            if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute()))
+                info.attributes[it.name()] = s->value();
+        info.complete = file.isComplete() && chunksInFile(path);
+        return info;
+    } catch (const std::exception& e) {
+        throw InputError(strCat(path.string(), ": cannot read OpenEXR file: ", e.what()));
+    }
+}
+
 Film filmFromExr(const ExrImage& image) {
     Film film(image.width, image.height);
     const auto has = [&](const std::string& name) {

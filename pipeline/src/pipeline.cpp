@@ -1,3 +1,4 @@
+#include "asset_cache.h"
 #include "dual_scattering_fragment_shader.h"
 #include "frame_reuse.h"
 #include "surfaces.h"
@@ -315,11 +316,13 @@ FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, Sc
     assets->times.load = secondsSince(start);
     throwIfInterrupted();
 
-    const std::uint64_t groom = reuse ? detail::groomKey(assets->groom.groom) : 0;
+    const DiskCache* disk = options.diskCache.get();
+    const bool keyed = reuse || disk;
+    const std::uint64_t groom = keyed ? detail::groomKey(assets->groom.groom) : 0;
     if (scene.globalTermMode != GlobalTermMode::Exact || scene.integrator == Integrator::Volumetric) {
         checkVoxelSizeForGroom(scene, assets->groom.groom);
         const SplatOptions splat = splatOptions(scene, options);
-        if (reuse)
+        if (keyed)
             out.gridKey = detail::gridKey(groom, splat);
         if (reuse && reuse->assets && reuse->assets->grid && reuse->gridKey == out.gridKey) {
             out.gridReused = true;
@@ -327,14 +330,17 @@ FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, Sc
             if (reuse)
                 reuse->release();
             start = Clock::now();
-            assets->grid =
-                std::make_shared<const FiberGrid>(splatStrands(assets->groom.groom, splat));
+            assets->grid = std::make_shared<const FiberGrid>(
+                disk ? detail::splatOrLoad(assets->groom.groom, splat, *disk, out.gridKey,
+                                           options.diskCacheStoresGrid)
+                     : splatStrands(assets->groom.groom, splat));
             assets->times.voxelize = secondsSince(start);
         }
     }
-    if (reuse) {
+    if (keyed)
         out.modelKey =
             detail::modelKey(groom, out.gridKey, scene, options, assets->groom, assets->surfaces);
+    if (reuse) {
         if (reuse->assets && reuse->modelKey == out.modelKey) {
             // The same groom, surfaces, grid and model: the frame before's.
             out.reused = reuse->assets.get();
@@ -348,11 +354,14 @@ FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, Sc
     start = Clock::now();
     TableBuildOptions tableOptions;
     tableOptions.d_b = scene.dualScattering.d_b;
+    // The tables' own disk cache: given, or beside the shared grids and lights.
+    std::filesystem::path tableCacheDir = options.tableCacheDir;
+    if (tableCacheDir.empty())
+        tableCacheDir = disk ? disk->directory() : defaultTableCacheDir();
     CrossingTables crossings;
     for (const FiberParams& fiber : assets->groom.palette.fibers) {
-        assets->tables.push_back(DualScatteringTables::loadOrBuild(
-            fiber, options.tableCacheDir.empty() ? defaultTableCacheDir() : options.tableCacheDir,
-            tableOptions));
+        assets->tables.push_back(
+            DualScatteringTables::loadOrBuild(fiber, tableCacheDir, tableOptions));
         crossings.push_back(CrossingTable::fromDualScattering(assets->tables.back()));
     }
     assets->times.tables = secondsSince(start);
@@ -360,6 +369,12 @@ FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, Sc
     start = Clock::now();
     GlobalTermSettings settings = globalTermSettings(scene, assets->surfaces);
     settings.groom = &assets->groom.groom;
+    settings.diskCache = disk;
+    settings.diskCacheKey = out.modelKey;
+    if (!options.diskCacheSkipsLights.empty())
+        settings.diskCacheStores = [skip = options.diskCacheSkipsLights](const Light& light) {
+            return skip.count(light.name) == 0;
+        };
     GridOptions gridOptions = options.grid;
     if (scene.fiberSampleSpacing)
         gridOptions.fiberSampleSpacing = *scene.fiberSampleSpacing;
@@ -588,6 +603,7 @@ SceneRender renderRasterized(const Scene& scene, const PipelineOptions& options,
     if (assets->grid)
         result.outputAttributes["hairvox:voxel_size"] =
             std::to_string(assets->grid->info.voxelSize);
+    result.outputAttributes.insert(options.outputAttributes.begin(), options.outputAttributes.end());
     if (writeFiles) {
         const auto start = Clock::now();
         result.written = writeOutputs(result.film, scene, result.outputAttributes);
@@ -662,6 +678,7 @@ SceneRender renderPathTraced(const Scene& scene, const PipelineOptions& options,
     result.outputAttributes = {{"hairvox:spp", std::to_string(traced.stats.spp)},
                                {"hairvox:seed", std::to_string(scene.pathTrace.seed)},
                                {"hairvox:pathTraceHash", hash}};
+    result.outputAttributes.insert(options.outputAttributes.begin(), options.outputAttributes.end());
     if (writeFiles && traced.stats.spp > previousSpp) {
         start = Clock::now();
         result.written = writeOutputs(result.film, scene, result.outputAttributes);

@@ -7,6 +7,7 @@
 
 #include <fstream>
 #include <sstream>
+#include <unistd.h>
 
 namespace hairvox {
 namespace {
@@ -46,6 +47,23 @@ TEST(CoreAtomicFile, FailedWriteKeepsOldFileAndRemovesTemporary) {
                  InputError);
     EXPECT_EQ(readAll(target), "old");
     EXPECT_EQ(entriesIn(dir.path()), 1u);
+}
+
+TEST(CoreAtomicFile, TemporaryNamesHoldTheHostAndTheProcess) {
+    // Tasks on several machines write into one shared directory: process ids
+    // repeat across machines, so the host is in the name too.
+    test::TempDir dir;
+    const auto target = dir / "frame.0001.exr";
+    char host[256] = {};
+    ASSERT_EQ(::gethostname(host, sizeof(host) - 1), 0);
+    std::string name;
+    writeFileAtomically(target, [&](const std::filesystem::path& tmp) {
+        name = tmp.filename().string();
+        test::writeText(tmp, "x");
+    });
+    EXPECT_EQ(temporaryPrefix(target), ".frame.0001.exr.tmp-");
+    EXPECT_EQ(name.rfind(temporaryPrefix(target), 0), 0u) << name;
+    EXPECT_TRUE(test::contains(name, strCat("-", host, "-", ::getpid(), "-"))) << name;
 }
 
 TEST(CoreAtomicFile, RefusesDirectoryTarget) {

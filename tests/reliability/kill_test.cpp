@@ -2,7 +2,7 @@
 // moment — while computing, while writing the EXR or the PNG, while writing the
 // table cache — leaves under each final name either the previous file or the
 // complete new one (byte-identical to an uninterrupted render: renders are
-// deterministic), never a partial file. Hidden temporaries (".NAME.tmp-PID-N")
+// deterministic), never a partial file. Hidden temporaries (".NAME.tmp-HOST-PID-N")
 // may remain after SIGKILL; they are not outputs.
 #include "render_run.h"
 

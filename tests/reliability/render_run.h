@@ -52,7 +52,7 @@ inline ChildOptions renderOptions(const std::filesystem::path& scene,
     return options;
 }
 
-/// Hidden temporaries of writeFileAtomically() in `dir` (".NAME.tmp-PID-N").
+/// Hidden temporaries of writeFileAtomically() in `dir` (".NAME.tmp-HOST-PID-N").
 inline std::vector<std::string> temporaries(const std::filesystem::path& dir) {
     std::vector<std::string> names;
     std::error_code ec;

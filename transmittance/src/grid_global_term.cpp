@@ -3,7 +3,9 @@
 #include "brick_volume.h"
 #include "light_space_cache.h"
 
+#include <hairvox/core/disk_cache.h>
 #include <hairvox/core/error.h>
+#include <hairvox/core/hash.h>
 #include <hairvox/core/interrupt.h>
 #include <hairvox/core/thread_scratch.h>
 #include <hairvox/transmittance/grid_global_term.h>
@@ -15,6 +17,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <iostream>
 #include <limits>
 #include <optional>
 #include <vector>
@@ -67,6 +70,9 @@ std::ostream& operator<<(std::ostream& os, const GridOptions& options) {
 }
 
 namespace {
+
+/// The disk cache's kind of a light's prepared cache (core/disk_cache.h).
+constexpr const char* kLightCacheKind = "light";
 
 /// Beyond this optical depth in n and every channel of tauP, V and P are
 /// below 1e-7: the rest of the path cannot change the global term.
@@ -138,6 +144,17 @@ public:
 
     /// The crossing table of fiber type `type`.
     const CrossingTable& crossings(std::uint8_t type) const { return crossings_.at(type); }
+    /// The disk cache's key of a light's prepared cache: the caller's key of
+    /// the grid, tables and settings (GlobalTermSettings::diskCacheKey), what
+    /// of the options the cache is made of, and the light.
+    std::uint64_t lightCacheKey(const Light& light) const {
+        Hasher h;
+        h.value(settings_.diskCacheKey).value(mode_);
+        options_.hashInto(h);
+        settings_.fiberScale.hashInto(h);
+        light.hashInto(h);
+        return h.digest();
+    }
     const GlobalTermSettings& settings() const { return settings_; }
     const GridOptions& options() const { return options_; }
     double voxelSize() const { return grid_.info.voxelSize; }
@@ -242,6 +259,22 @@ public:
     GridLightGlobalTerm(const GridModel& model, const Light& light, RatesWorkspace* workspace)
         : model_(model)
         , light_(light) {
+        // A cache another process prepared (GlobalTermSettings::diskCache).
+        const DiskCache* disk = model.options().evaluation == GridEvaluation::Cache
+                                    ? model.settings().diskCache
+                                    : nullptr;
+        const std::uint64_t key = disk ? model.lightCacheKey(light) : 0;
+        if (disk) {
+            if (const auto bytes = disk->load(kLightCacheKind, key)) {
+                cache_ = LightSpaceCache::deserialize(*bytes);
+                if (cache_)
+                    return;
+                std::cerr << "hairvox: warning: cache entry "
+                          << disk->entryPath(kLightCacheKind, key).string()
+                          << " is not a light-space cache of this build; computed again\n";
+                disk->discard(kLightCacheKind, key);
+            }
+        }
         BrickVolume rates =
             workspace && workspace->rates ? std::move(*workspace->rates) : model.reserveRates();
         if (workspace)
@@ -256,6 +289,10 @@ public:
             rates_.emplace(std::move(rates));
         else if (workspace)
             workspace->rates.emplace(std::move(rates));
+        // (A point light inside the volume marches: nothing to keep.)
+        const auto& stores = model.settings().diskCacheStores;
+        if (disk && cache_ && (!stores || stores(light)))
+            disk->store(kLightCacheKind, key, cache_->serialize());
     }
 
     std::size_t memoryBytes() const override {

@@ -22,6 +22,7 @@
 #include <hairvox/core/large_array.h>
 #include <hairvox/geometry/light.h>
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -45,6 +46,14 @@ public:
     /// misses of different points overlap. A point's value does not depend on
     /// the others.
     void lookup(std::span<const Vec3f> points, std::span<OpticalDepths> out) const;
+
+    /// The cache as bytes (host byte order, for a disk cache on machines of
+    /// one architecture; light_space_cache_io.cpp), and back: nullopt for
+    /// bytes that are not a cache this code wrote, or whose lines, runs and
+    /// samples do not fit together (so that no lookup reads out of bounds).
+    /// deserialize(serialize()) looks up the same values bit for bit.
+    std::vector<std::byte> serialize() const;
+    static std::optional<LightSpaceCache> deserialize(std::span<const std::byte> bytes);
 
     std::size_t lineCount() const { return std::size_t(ni_) * std::size_t(nj_); }
     /// Samples stored over every line.

@@ -1,8 +1,9 @@
 // hairvox core: outputs are never half-written.
 //
 // Every output (.hair, .vdb, .exr, .png, caches, CSV) is written to a hidden
-// temporary file in the destination directory and renamed over the final name
-// only once complete and flushed to disk. If writing throws (bad data, Ctrl-C),
+// temporary file in the destination directory — ".NAME.tmp-HOST-PID-N", unique
+// among the processes of every machine sharing the directory — and renamed
+// over the final name only once complete and flushed to disk. If writing throws (bad data, Ctrl-C),
 // the temporary is removed and an existing file under the final name is left
 // untouched.
 #pragma once
@@ -17,5 +18,10 @@ namespace hairvox {
 /// `finalPath` when the destination cannot be written.
 void writeFileAtomically(const std::filesystem::path& finalPath,
                          const std::function<void(const std::filesystem::path& tmpPath)>& write);
+
+/// What the name of each temporary of `finalPath` starts with: ".NAME.tmp-".
+/// One left behind belongs to a process killed outright (SIGKILL, a node
+/// lost); it is never an output.
+std::string temporaryPrefix(const std::filesystem::path& finalPath);
 
 } // namespace hairvox

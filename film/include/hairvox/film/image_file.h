@@ -85,6 +85,18 @@ struct ExrImage {
 /// Throws InputError naming the file if it cannot be read.
 ExrImage readExr(const std::filesystem::path& path);
 
+/// What an EXR file's header says, its pixels not read: the string
+/// attributes, the size, and whether every chunk of the data window is in
+/// the file (OpenEXR's isComplete(): false for a file cut short).
+struct ExrInfo {
+    int width = 0, height = 0;
+    std::map<std::string, std::string> attributes;
+    bool complete = false;
+};
+
+/// Throws InputError naming the file if it is not a readable EXR.
+ExrInfo readExrInfo(const std::filesystem::path& path);
+
 /// The film an EXR image holds: channels R, G, B as the beauty layer "",
 /// X.R, X.G, X.B as the RGB layer X, any other channel as a scalar layer of its
 /// name; every layer full precision. (writeExr's inverse, up to half rounding.)

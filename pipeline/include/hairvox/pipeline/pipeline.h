@@ -11,6 +11,7 @@
 // same way.
 #pragma once
 
+#include <hairvox/core/disk_cache.h>
 #include <hairvox/film/image_compare.h>
 #include <hairvox/pathtrace/path_tracer.h>
 #include <hairvox/pipeline/scene.h>
@@ -27,6 +28,7 @@
 #include <memory>
 #include <optional>
 #include <ostream>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -45,6 +47,20 @@ struct PipelineOptions {
     /// (SplatOptions::memoryBudgetBytes) shrinks to what the estimate leaves.
     /// 0: defaultMemoryLimit() in renderScene(), no limit in loadSceneAssets().
     std::uint64_t maxMemoryBytes = 0;
+    /// A cache shared by the processes of many machines (a shot's render
+    /// tasks on a farm, docs/farm.md): the fiber grid and the grid modes'
+    /// per-light caches are taken from it where it holds them (keyed by what
+    /// they are made of, as FrameReuse's keys) and stored there otherwise.
+    /// The same bytes either way. Null: none.
+    std::shared_ptr<const DiskCache> diskCache;
+    /// What the disk cache is given to keep: what other frames share. A
+    /// shot's per-frame groom makes a grid (and light preparations) of one
+    /// frame, an orbiting light a preparation of one frame: kept, they would
+    /// only fill the disk. Entries are looked for in any case.
+    bool diskCacheStoresGrid = true;
+    std::set<std::string> diskCacheSkipsLights; ///< by name
+    /// String attributes added to the EXR output (a shot frame's hash).
+    std::map<std::string, std::string> outputAttributes;
 };
 
 /// The default memory limit: 3/4 of the physical memory (sysconf), 8 GiB if unknown.

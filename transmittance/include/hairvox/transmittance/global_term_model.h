@@ -22,12 +22,15 @@
 #include <hairvox/transmittance/global_term_mode.h>
 
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <optional>
 #include <span>
 
 namespace hairvox {
+
+class DiskCache;
 
 inline constexpr std::uint32_t kUnknownSegment = std::numeric_limits<std::uint32_t>::max();
 
@@ -96,6 +99,17 @@ struct GlobalTermSettings {
     /// the fibers (GridOptions::fiberSampleSpacing). Null: every query is
     /// evaluated. Must outlive the model.
     const Groom* groom = nullptr;
+    /// Where the grid modes keep each light's prepared cache for other
+    /// processes (the render tasks of a shot, on other machines) and look for
+    /// it first, or null. Its entries are keyed by `diskCacheKey` — the
+    /// caller's digest of everything besides the light that the preparation
+    /// is made of: the fiber grid's and the crossing tables' contents, the
+    /// fiber scale and the grid options — and the light. Must outlive the model.
+    const DiskCache* diskCache = nullptr;
+    std::uint64_t diskCacheKey = 0;
+    /// The lights whose preparation is stored there (null: every light's);
+    /// a light that moves from frame to frame is prepared for one frame only.
+    std::function<bool(const Light&)> diskCacheStores;
 
     void validate() const;
 };

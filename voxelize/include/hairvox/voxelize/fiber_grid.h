@@ -83,9 +83,11 @@
 #include <openvdb/openvdb.h>
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <ostream>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -257,5 +259,17 @@ void writeVdbFile(const std::filesystem::path& path, const openvdb::GridPtrVec& 
 /// voxels are leaf voxels). The other grids are read at the density's active
 /// voxels.
 FiberGrid readFiberGrid(const std::filesystem::path& path);
+
+/// The grid as it is in memory — its blocks, value arrays and info — as
+/// bytes, for the disk cache that a farm's render tasks share
+/// (core/disk_cache.h; host byte order). Not a .vdb: a cache entry is read
+/// by a task's first frame, and OpenVDB's trees cost that read more than the
+/// splat it saves (fiber_grid_bytes.cpp has the figures).
+std::vector<std::byte> fiberGridBytes(const FiberGrid& grid);
+/// The grid of fiberGridBytes() (the same blocks, values and info), or
+/// InputError naming `name` for bytes that are not one — blocks out of
+/// order or off the 8³ lattice, counts that disagree with the masks, values
+/// a fiber grid cannot hold (readFiberGrid's rules).
+FiberGrid fiberGridFromBytes(std::span<const std::byte> bytes, const std::string& name);
 
 } // namespace hairvox
