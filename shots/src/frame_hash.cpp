@@ -81,6 +81,7 @@ void hashSceneInto(Hasher& h, const Scene& s) {
     h.value(s.integrator);
     const PathTraceSettings& pt = s.pathTrace;
     h.value(pt.spp).value(pt.timeLimit).value(pt.maxDepth).value(pt.rouletteDepth).value(pt.seed);
+    s.volumetric.hashInto(h);
     h.value(s.globalTermMode);
     h.value(s.exact.rays).value(s.exact.radius).value(s.exact.seed);
     h.value(s.shadingRate).value(s.shadingTolerance).value(s.tailTransmittance);

@@ -155,10 +155,10 @@ TEST(BenchSweep, TinySweepWritesTablesAndPlots) {
     const SweepResult result = runSweep(o);
 
     // 1 reference + 3 rates × (1 exact + 2 grid + 2 approx) + 2 melanins × (1
-    // path reference + 2 modes) + 2 + 2 + 2 scaling rows.
-    ASSERT_EQ(result.rows.size(), 28u);
+    // path reference + 2 modes + volumetric) + 2 + 2 + 2 scaling rows.
+    ASSERT_EQ(result.rows.size(), 30u);
     const auto csv = readCsv(o.outDir / "results.csv");
-    ASSERT_EQ(csv.size(), 29u);
+    ASSERT_EQ(csv.size(), 31u);
     ASSERT_EQ(csv[0].size(), kBenchCsvColumns.size());
     for (std::size_t i = 0; i < kBenchCsvColumns.size(); ++i)
         EXPECT_EQ(csv[0][i], kBenchCsvColumns[i]);
@@ -216,8 +216,8 @@ TEST(BenchSweep, TinySweepWritesTablesAndPlots) {
     EXPECT_EQ(result.fits[2].kind, BenchSweepKind::Voxels);
     // Halving the voxel size gives the tiny groom more active voxels (the fit's x).
     const auto voxelsOf = [&](std::size_t r) { return std::stod(csv[r][column("active_voxels")]); };
-    EXPECT_GT(voxelsOf(28), voxelsOf(27));
-    EXPECT_NEAR(std::stod(csv[28][column("voxel_size")]), 0.012, 1e-6);
+    EXPECT_GT(voxelsOf(30), voxelsOf(29));
+    EXPECT_NEAR(std::stod(csv[30][column("voxel_size")]), 0.012, 1e-6);
     for (const ScalingFit& fit : result.fits) {
         ASSERT_TRUE(fit.total);
         ASSERT_TRUE(fit.prepare);
@@ -234,7 +234,8 @@ TEST(BenchSweep, TinySweepWritesTablesAndPlots) {
           "## Scaling with image size", "cost ∝ pixels^k: total time k = ",
           "## Scaling with active voxels", "| tiny 24 mm | 0.024 |",
           "cost ∝ active voxels^k: total time k = ",
-          "## Model error: dual scattering against path tracing", "| tiny, dark | grid | "})
+          "## Model error: dual scattering against path tracing", "| tiny, dark | grid | ",
+          "| tiny, dark | volumetric | "})
         EXPECT_NE(text.find(needle), std::string::npos) << needle << "\n" << text;
 
     // matplotlib figures (bench/sweep/plot_sweep.py): 14 × 6.5 in at 110 dpi (per pixel and

@@ -184,6 +184,7 @@ json jobToJson(const BenchJob& job) {
             {"block", job.block},
             {"scene", sceneToJson(job.scene)},
             {"mode", toString(job.config.mode)},
+            {"integrator", toString(job.config.integrator)},
             {"voxel_scale", job.config.voxelScale},
             {"rays", job.config.rays},
             {"shading_rate", toString(job.config.shadingRate)},
@@ -211,6 +212,8 @@ BenchJob jobFromJson(const json& j) {
     job.block = j.at("block").get<int>();
     job.scene = sceneFromJson(j.at("scene"));
     job.config.mode = kGlobalTermModeNames.parse(j.at("mode").get<std::string>()).value();
+    job.config.integrator =
+        kIntegratorNames.parse(j.at("integrator").get<std::string>()).value();
     job.config.voxelScale = j.at("voxel_scale").get<double>();
     job.config.rays = j.at("rays").get<std::uint32_t>();
     job.config.shadingRate =

@@ -73,8 +73,8 @@ ProbeError meanProbeError(const std::vector<std::vector<GlobalTerm>>& estimate,
 /// run is longer than singleRunAbove) and takes medians.
 BenchMeasurement timeRenders(const Scene& scene, const BenchJob& job,
                              const PipelineOptions& options, Film* lastFilm) {
-    std::vector<double> load, voxelize, tables, globalTerm, prepare, raster, shade, trace, write,
-        total;
+    std::vector<double> load, voxelize, tables, globalTerm, multiple, prepare, raster, shade, trace,
+        write, total;
     BenchMeasurement m;
     int runs = job.runs;
     for (int r = 0; r < runs; ++r) {
@@ -84,6 +84,7 @@ BenchMeasurement timeRenders(const Scene& scene, const BenchJob& job,
         voxelize.push_back(t.voxelize);
         tables.push_back(t.tables);
         globalTerm.push_back(t.globalTerm);
+        multiple.push_back(t.multiple);
         prepare.push_back(render.globalTermPrepareSeconds);
         raster.push_back(t.raster);
         shade.push_back(t.shade);
@@ -106,6 +107,7 @@ BenchMeasurement timeRenders(const Scene& scene, const BenchJob& job,
     m.times.voxelize = median(voxelize);
     m.times.tables = median(tables);
     m.times.globalTerm = median(globalTerm);
+    m.times.multiple = median(multiple);
     m.times.raster = median(raster);
     m.times.shade = median(shade);
     m.times.trace = median(trace);
@@ -126,6 +128,7 @@ BenchMeasurement runJob(const BenchJob& job) {
     scene.output.exr = job.scratch / "render.exr";
     scene.output.png = job.scratch / "render.png";
     scene.globalTermMode = job.config.mode;
+    scene.integrator = job.config.integrator;
     scene.shadingRate = job.config.shadingRate;
     PipelineOptions options;
     options.threads = job.threads;

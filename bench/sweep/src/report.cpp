@@ -103,7 +103,7 @@ std::string modelMarkdown(const SweepOptions& o, const std::vector<BenchRow>& ro
         "two independent halves); `noise removed`: sqrt(L1² − floor²) — an error within 1.5× "
         "its floor is not resolved (marked ~). `bias`: signed, dual scattering brighter when "
         "positive. Target: grid within 0.05 with the noise removed.\n\n");
-    md += "| scene, hair | mode | rel L1 | floor | noise removed | bias | DS s | reference s | "
+    md += "| scene, hair | method | rel L1 | floor | noise removed | bias | s | reference s | "
           "spp | Mrays/s | Mpaths/s |\n";
     md += "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     for (const std::string& s : scenes) {
@@ -114,7 +114,7 @@ std::string modelMarkdown(const SweepOptions& o, const std::vector<BenchRow>& ro
                 continue;
             const ImageError& e = *r.m.image;
             const PathTraceStats* pt = ref && ref->m.pathTrace ? &*ref->m.pathTrace : nullptr;
-            md += strCat("| ", s, " | ", toString(r.config.mode), " | ", format("%.4f", e.relL1),
+            md += strCat("| ", s, " | ", r.config.method(), " | ", format("%.4f", e.relL1),
                          " | ", format("%.4f", e.noiseFloorL1), " | ", e.resolved() ? "" : "~",
                          format("%.4f", e.relL1NoiseRemoved), " | ", format("%+.4f", e.relBias),
                          " | ", seconds(r.m.totalSeconds), " | ",
@@ -154,7 +154,7 @@ std::string csvText(const std::vector<BenchRow>& rows) {
         const std::vector<std::string> cells = {
             toString(r.kind),
             r.scene,
-            toString(r.config.mode),
+            r.config.method(),
             csvNumber(r.config.voxelScale),
             csvNumber(m.voxelSize),
             r.config.mode == GlobalTermMode::Exact ? std::to_string(r.config.rays) : "",

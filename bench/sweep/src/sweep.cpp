@@ -104,7 +104,13 @@ BenchScene BenchScene::atWidth(std::uint32_t w) const {
     return s;
 }
 
+std::string BenchConfig::method() const {
+    return integrator == Integrator::Volumetric ? toString(integrator) : toString(mode);
+}
+
 std::string BenchConfig::label() const {
+    if (integrator == Integrator::Volumetric)
+        return method();
     if (mode == GlobalTermMode::Exact)
         return strCat("exact K=", rays);
     return strCat(toString(mode), " x", scaleText(voxelScale));
@@ -356,7 +362,8 @@ SweepResult runSweep(const SweepOptions& o) {
     const std::size_t jobCount =
         o.scenes.size() * perScene + o.segmentScaling.size() + o.pixelScaling.size() +
         o.voxelScaling.size() +
-        o.model.scenes.size() * o.model.melanins.size() * (1 + o.model.modes.size());
+        o.model.scenes.size() * o.model.melanins.size() *
+        (1 + o.model.modes.size() + (o.model.volumetric ? 1 : 0));
     std::size_t jobIndex = 0;
     const auto start = Clock::now();
 
@@ -484,6 +491,15 @@ SweepResult runSweep(const SweepOptions& o) {
                 BenchJob job;
                 job.scene = scene;
                 job.config = {mode, 1.0, 1, ShadingRate::Fragment};
+                job.referenceImage = ref.referenceImage;
+                job.block = o.model.block;
+                run(job, BenchSweepKind::Model);
+            }
+            if (o.model.volumetric) {
+                BenchJob job;
+                job.scene = scene;
+                job.config = {GlobalTermMode::Grid, 1.0, 1, ShadingRate::Fragment,
+                              Integrator::Volumetric};
                 job.referenceImage = ref.referenceImage;
                 job.block = o.model.block;
                 run(job, BenchSweepKind::Model);

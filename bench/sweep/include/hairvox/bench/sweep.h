@@ -41,7 +41,8 @@
 // the light transport it approximates. Each scene × hair colour (a eumelanin
 // concentration) is path traced — the reference, of the same fibers with the
 // same f_s (pathtrace/), its two independent halves giving its noise — and
-// rendered with dual scattering in each global-term mode. The hair's radiance
+// rendered with dual scattering in each global-term mode and with the
+// volumetric integrator (docs/DESIGN.md §9). The hair's radiance
 // (pipeline's hairRadianceOf: the beauty without head and background) is
 // compared as means over block × block pixels, where the rasterizer's point
 // sampling and the path tracer's per-pixel noise average out but a bias does
@@ -112,9 +113,14 @@ struct BenchConfig {
     double voxelScale = 1;
     std::uint32_t rays = 1; ///< exact: rays per shading point
     ShadingRate shadingRate = ShadingRate::Fragment;
+    /// Dual scattering (the mode above) or volumetric (the model sweep: its
+    /// single scattering in grid mode, its multiple scattering solved on the grid).
+    Integrator integrator = Integrator::DualScattering;
 
-    /// "grid x1.4", "exact K=4".
+    /// "grid x1.4", "exact K=4", "volumetric".
     std::string label() const;
+    /// The mode's name, or "volumetric" (the model sweep's and the CSV's "mode").
+    std::string method() const;
 };
 
 /// y ≈ coefficient · x^exponent by least squares on (ln x, ln y).
@@ -215,6 +221,8 @@ struct ModelSweepOptions {
         {"blond", 0.3f}, {"medium", 1.3f}, {"dark", 3.0f}};
     std::vector<GlobalTermMode> modes{GlobalTermMode::Exact, GlobalTermMode::Grid,
                                       GlobalTermMode::Approx};
+    /// The volumetric integrator in every cell too, beside dual scattering.
+    bool volumetric = true;
     std::uint32_t spp = 256; ///< of each path-traced reference, [2, 10^6]
     double timeLimit = 0;    ///< seconds per reference, 0: none; the first of spp and this stops it
     int block = 8;           ///< side in pixels of the compared blocks, [1, 64]
