@@ -162,7 +162,35 @@ MemoryEstimate estimateRenderMemory(const Scene& scene) {
             m.meshes += ec ? 0 : std::uint64_t(size) * (1 + kBytesPerTriangle / 40);
         }
     }
+    if (scene.environment && !scene.environment->file.empty()) {
+        try {
+            const ExrInfo info = readExrInfo(scene.environment->file);
+            m.environment = std::uint64_t(std::max<std::int64_t>(info.width, 0)) *
+                            std::uint64_t(std::max<std::int64_t>(info.height, 0)) *
+                            EnvironmentMap::kBytesPerPixel;
+        } catch (const InputError&) {
+            // loadEnvironment() names the problem with the file.
+        }
+    }
     return m;
+}
+
+std::shared_ptr<const EnvironmentMap> loadEnvironment(const Scene& scene, std::uint64_t maxBytes) {
+    if (!scene.environment)
+        return nullptr;
+    const EnvironmentLight& e = *scene.environment;
+    const Rgb scale = e.intensity * e.color;
+    try {
+        if (e.file.empty()) {
+            EnvironmentMap uniform = EnvironmentMap::uniform(scale);
+            return std::make_shared<const EnvironmentMap>(std::move(uniform));
+        }
+        return std::make_shared<const EnvironmentMap>(
+            EnvironmentMap::readExr(e.file, scale, e.rotation, maxBytes));
+    } catch (const InputError& error) {
+        throw InputError(
+            strCat(scene.name, ": environment light \"", e.name, "\": ", error.what()));
+    }
 }
 
 void checkVoxelSizeForGroom(const Scene& scene, const Groom& groom) {
@@ -542,8 +570,9 @@ SceneRender renderPathTraced(const Scene& scene, const PipelineOptions& options,
     const SceneSurfaces surfaces = loadSurfaces(scene);
     for (const std::string& w : surfaces.warnings)
         result.warnings.push_back(w);
+    const std::shared_ptr<const EnvironmentMap> environment = loadEnvironment(scene);
     result.times.load = secondsSince(start);
-    const std::string hash = pathTraceHash(scene, sceneGroom, surfaces);
+    const std::string hash = pathTraceHash(scene, sceneGroom, surfaces, environment.get());
 
     // Continue from the scene's own earlier output, if asked and it is there.
     std::optional<Film> previous;
@@ -580,6 +609,8 @@ SceneRender renderPathTraced(const Scene& scene, const PipelineOptions& options,
     pts.surfaces = surfaces.scene;
     pts.surfaceAlbedo = surfaces.albedo;
     pts.background = scene.background;
+    pts.environment = environment;
+    pts.environmentVisible = scene.environment && scene.environment->visible;
     PathTraceSettings settings = scene.pathTrace;
     settings.threads = options.threads;
     settings.progress = options.progress;
@@ -653,7 +684,7 @@ ComparedImage hairRadianceOf(const Film& film) {
 }
 
 std::string pathTraceHash(const Scene& scene, const SceneGroom& groom,
-                          const SceneSurfaces& surfaces) {
+                          const SceneSurfaces& surfaces, const EnvironmentMap* environment) {
     Hasher h;
     h.value(contentHash(groom.groom));
     h.values(std::span<const float>(groom.groom.thickness));
@@ -679,6 +710,11 @@ std::string pathTraceHash(const Scene& scene, const SceneGroom& groom,
         for (const TriangleMesh& m : surfaces.scene->meshes())
             h.value(m.contentHash());
     h.value(scene.background);
+    h.value(environment != nullptr);
+    if (environment) {
+        environment->hashInto(h);
+        h.value(scene.environment && scene.environment->visible);
+    }
     h.value(scene.pathTrace.seed)
         .value(scene.pathTrace.maxDepth)
         .value(scene.pathTrace.rouletteDepth);

@@ -85,6 +85,28 @@ struct ExrImage {
 /// Throws InputError naming the file if it cannot be read.
 ExrImage readExr(const std::filesystem::path& path);
 
+/// An EXR's colour: its R, G and B channels as floats.
+struct ExrRgbImage {
+    int width = 0, height = 0;
+    std::vector<float> rgb; ///< row-major, 3 floats a pixel (R, G, B)
+};
+
+/// What an EXR file's header says of its pixels.
+struct ExrInfo {
+    std::int64_t width = 0, height = 0; ///< of the data window
+    std::vector<std::string> channels;  ///< their names, in the file's order
+};
+/// Reads the header only. InputError naming the file if it cannot be read.
+ExrInfo readExrInfo(const std::filesystem::path& path);
+
+/// Reads the R, G and B channels of an EXR file (half, float or uint; any
+/// compression OpenEXR reads, DWA included; scanline or tiled; the first part
+/// of a multi-part file); an alpha or any other channel is ignored. Checks its
+/// header first: InputError naming the file if it cannot be read, lacks one
+/// of R, G, B (the message lists its channels) or holds more than maxPixels
+/// pixels (nothing is allocated for it then).
+ExrRgbImage readExrRgb(const std::filesystem::path& path, std::uint64_t maxPixels);
+
 /// The film an EXR image holds: channels R, G, B as the beauty layer "",
 /// X.R, X.G, X.B as the RGB layer X, any other channel as a scalar layer of its
 /// name; every layer full precision. (writeExr's inverse, up to half rounding.)

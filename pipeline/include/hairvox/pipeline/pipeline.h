@@ -12,6 +12,7 @@
 #pragma once
 
 #include <hairvox/film/image_compare.h>
+#include <hairvox/geometry/environment_map.h>
 #include <hairvox/pathtrace/path_tracer.h>
 #include <hairvox/pipeline/scene.h>
 #include <hairvox/render/rasterizer.h>
@@ -61,11 +62,14 @@ struct MemoryEstimate {
     std::uint64_t film = 0;  ///< film layers + per-pixel integrator buffers + output encoding
     std::uint64_t groom = 0; ///< points, per-point render buffers, acceleration structure
     std::uint64_t meshes = 0; ///< the OBJ text while read, triangles, normals, Embree's BVH
+    /// The environment map (EnvironmentMap::kBytesPerPixel a pixel, from its
+    /// file's header; 0 when the header cannot be read: loading says why).
+    std::uint64_t environment = 0;
     /// Libraries, tables, the fiber grid and per-light caches of a typical
     /// groom (the default scene peaks at ~1.1 GiB at 2000², ~430 MiB at 500²).
     std::uint64_t fixed = 320ull << 20;
     int filmChannels = 0; ///< float channels per pixel in the film
-    std::uint64_t total() const { return film + groom + meshes + fixed; }
+    std::uint64_t total() const { return film + groom + meshes + environment + fixed; }
 };
 MemoryEstimate estimateRenderMemory(const Scene& scene);
 
@@ -101,6 +105,18 @@ struct SceneSurfaces {
 /// surface scene. InputError (naming the scene's meshes[i] and the file)
 /// for a mesh that cannot be used.
 SceneSurfaces loadSurfaces(const Scene& scene);
+
+/// What an environment map may take at most: 1 GiB (26.8M pixels, e.g. 7300 x
+/// 3650, at EnvironmentMap::kBytesPerPixel).
+inline constexpr std::uint64_t kEnvironmentBudgetBytes = 1ull << 30;
+
+/// The scene's environment map, read from its file (with its colour,
+/// intensity and rotation) or uniform; null when the scene has none.
+/// InputError naming the scene, the light and the file for a map that cannot
+/// be used (geometry/environment_map.h: unreadable, not RGB, not 2:1,
+/// negative or non-finite pixels, over `maxBytes`).
+std::shared_ptr<const EnvironmentMap>
+loadEnvironment(const Scene& scene, std::uint64_t maxBytes = kEnvironmentBudgetBytes);
 
 /// The scene's groom, generated or read from its file, with its per-point
 /// attributes resolved (groom_attributes.h): groom.thickness holds diameters
@@ -222,10 +238,12 @@ ComparedImage hairRadianceOf(const Film& film);
 
 /// What a path trace's samples depend on (groom content with its per-point
 /// diameters and fiber types, fiber scale, each fiber type's optics, lights,
-/// camera, surfaces and their content, background, seed, depth settings): the
+/// camera, surfaces and their content, background, the environment's pixels,
+/// colour, rotation and visibility, seed, depth settings): the
 /// key under which a run may continue another.
 std::string pathTraceHash(const Scene& scene, const SceneGroom& groom,
-                          const SceneSurfaces& surfaces);
+                          const SceneSurfaces& surfaces,
+                          const EnvironmentMap* environment = nullptr);
 
 /// The closing report: time per stage and what was skipped.
 void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& render);
