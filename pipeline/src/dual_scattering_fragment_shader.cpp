@@ -31,11 +31,13 @@ void put(float* out, const Rgb& c) {
 
 DualScatteringFragmentShader::DualScatteringFragmentShader(
     std::vector<DualScatteringShader> shaders, std::span<const std::uint8_t> fiberType,
-    std::vector<Light> lights, std::vector<std::shared_ptr<const LightGlobalTerm>> lightTerms)
+    std::vector<Light> lights, std::vector<std::shared_ptr<const LightGlobalTerm>> lightTerms,
+    ShadedEnvironment environment)
     : shaders_(std::move(shaders))
     , fiberType_(fiberType)
     , lights_(std::move(lights))
     , terms_(std::move(lightTerms))
+    , environment_(std::move(environment))
     , layout_(dualScatteringLayout(lights_))
     , stats_(lights_.size()) {}
 
@@ -107,25 +109,33 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
         }
     }
 
-    for (std::size_t l = 0; l < lightCount; ++l) {
-        if (terms_[l]) {
+    // The scene's lights, then the environment's (no AOVs of their own).
+    const std::size_t environmentCount = environment_.lights.size();
+    GlobalTermStats environmentStats;
+    for (std::size_t l = 0; l < lightCount + environmentCount; ++l) {
+        const bool ofEnvironment = l >= lightCount;
+        const std::shared_ptr<const LightGlobalTerm>& term =
+            ofEnvironment ? environment_.terms[l - lightCount] : terms_[l];
+        if (term) {
             const auto evalStart = std::chrono::steady_clock::now();
-            batchStats[l] = terms_[l]->evaluate(queries, terms);
+            (ofEnvironment ? environmentStats : batchStats[l]) += term->evaluate(queries, terms);
             globalTermNanos += nanosSince(evalStart);
         } else {
             std::fill(terms.begin(), terms.end(), GlobalTerm::blocked());
         }
-        for (std::size_t i = 0; i < points.size(); ++i) {
-            const GlobalTerm& g = terms[i];
-            float* lightOut = out.data() + i * stride + 3 * kRadianceLayers + l * kLightFloats;
-            lightOut[0] = g.V;
-            lightOut[1] = g.n;
-            put(lightOut + 2, g.T_s);
-            put(lightOut + 5, safeSqrt(g.sigma2_f));
-        }
-        if (!terms_[l])
+        if (!ofEnvironment)
+            for (std::size_t i = 0; i < points.size(); ++i) {
+                const GlobalTerm& g = terms[i];
+                float* lightOut = out.data() + i * stride + 3 * kRadianceLayers + l * kLightFloats;
+                lightOut[0] = g.V;
+                lightOut[1] = g.n;
+                put(lightOut + 2, g.T_s);
+                put(lightOut + 5, safeSqrt(g.sigma2_f));
+            }
+        if (!term)
             continue; // a skipped light contributes nothing
-        const Light& light = lights_[l];
+        const Light& light = ofEnvironment ? environment_.lights[l - lightCount] : lights_[l];
+        const float spread2 = ofEnvironment ? environment_.spread2[l - lightCount] : 0.0f;
         for (std::size_t t = 0; t < types; ++t) {
             ShadeBatch& batch = batches[t];
             if (light.kind == Light::Kind::Directional) {
@@ -139,7 +149,7 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
             }
             for (std::size_t k = 0; k < batch.size(); ++k)
                 batch.setGlobalTerm(k, terms[pointOf(t, k)]);
-            shaders_[t].shade(batch);
+            shaders_[t].shade(batch, spread2);
         }
     }
     for (std::size_t t = 0; t < types; ++t) {
@@ -159,6 +169,12 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
     const std::lock_guard lock(statsMutex_);
     for (std::size_t l = 0; l < lightCount; ++l)
         stats_[l] += batchStats[l];
+    environmentStats_ += environmentStats;
+}
+
+GlobalTermStats DualScatteringFragmentShader::environmentStats() const {
+    const std::lock_guard lock(statsMutex_);
+    return environmentStats_;
 }
 
 std::vector<GlobalTermStats> DualScatteringFragmentShader::stats() const {

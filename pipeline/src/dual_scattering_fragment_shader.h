@@ -9,6 +9,7 @@
 //             scattering)
 //   averages  per light l: l.V, l.n (scalars), l.T_s, l.sigma_f (RGB, σ_f = √σ_f²)
 // A point is shaded with the shader of its segment's fiber type (Groom::fiberType).
+// The environment's lights add to the radiance layers like the others.
 #pragma once
 
 #include <hairvox/geometry/light.h>
@@ -27,6 +28,14 @@ namespace hairvox::detail {
 /// The layout above for these lights.
 ShaderLayout dualScatteringLayout(std::span<const Light> lights);
 
+/// The environment's regions as lights (environment_lights.h): each shaded
+/// with its angular spread, into the radiance layers only (no per-light AOVs).
+struct ShadedEnvironment {
+    std::vector<Light> lights;
+    std::vector<float> spread2; ///< per light (DualScatteringShader::shade)
+    std::vector<std::shared_ptr<const LightGlobalTerm>> terms; ///< null: skipped
+};
+
 class DualScatteringFragmentShader final : public FragmentShader {
 public:
     /// `shaders[t]` shades fiber type t; `fiberType` is the groom's
@@ -35,7 +44,8 @@ public:
     /// for a light that is skipped (contributes nothing; its AOVs read "blocked").
     DualScatteringFragmentShader(std::vector<DualScatteringShader> shaders,
                                  std::span<const std::uint8_t> fiberType, std::vector<Light> lights,
-                                 std::vector<std::shared_ptr<const LightGlobalTerm>> lightTerms);
+                                 std::vector<std::shared_ptr<const LightGlobalTerm>> lightTerms,
+                                 ShadedEnvironment environment = {});
 
     const ShaderLayout& layout() const override { return layout_; }
     void shade(std::span<const ShadingPoint> points, std::span<float> out) const override;
@@ -45,16 +55,20 @@ public:
     double shadeThreadSeconds() const { return 1e-9 * double(shadeNanos_.load()); }
     /// Per light, summed over every batch.
     std::vector<GlobalTermStats> stats() const;
+    /// Over the environment's lights, summed over every batch.
+    GlobalTermStats environmentStats() const;
 
 private:
     std::vector<DualScatteringShader> shaders_; ///< per fiber type
     std::span<const std::uint8_t> fiberType_;
     std::vector<Light> lights_;
     std::vector<std::shared_ptr<const LightGlobalTerm>> terms_;
+    ShadedEnvironment environment_;
     ShaderLayout layout_;
     mutable std::atomic<std::int64_t> globalTermNanos_{0}, shadeNanos_{0};
     mutable std::mutex statsMutex_;
     mutable std::vector<GlobalTermStats> stats_;
+    mutable GlobalTermStats environmentStats_;
 };
 
 } // namespace hairvox::detail

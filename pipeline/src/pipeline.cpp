@@ -1,4 +1,5 @@
 #include "dual_scattering_fragment_shader.h"
+#include "environment_lights.h"
 #include "frame_reuse.h"
 #include "surfaces.h"
 
@@ -103,6 +104,11 @@ void warnIfNoHairSeen(const Scene& scene, bool hairSeen, const Groom* groom,
 
 } // namespace
 
+void EnvironmentOptions::hashInto(Hasher& hasher) const {
+    hasher.value(split).value(cacheSpacing).value(fiberSampleSpacing).value(surfaceSubdivisions);
+    hasher.value(spread);
+}
+
 std::uint64_t defaultMemoryLimit() {
     const long pages = sysconf(_SC_PHYS_PAGES);
     const long pageSize = sysconf(_SC_PAGE_SIZE);
@@ -192,6 +198,20 @@ std::shared_ptr<const EnvironmentMap> loadEnvironment(const Scene& scene, std::u
             strCat(scene.name, ": environment light \"", e.name, "\": ", error.what()));
     }
 }
+
+namespace {
+
+/// What the report says of the map itself.
+void describeEnvironment(const EnvironmentMap& map, const Scene& scene, EnvironmentReport& report) {
+    report.source = map.source();
+    report.width = map.width();
+    report.height = map.height();
+    report.mapBytes = map.memoryBytes();
+    report.folds = map.negativeFolds();
+    report.visible = scene.environment && scene.environment->visible;
+}
+
+} // namespace
 
 void checkVoxelSizeForGroom(const Scene& scene, const Groom& groom) {
     if (!scene.voxelSize || groom.empty())
@@ -333,6 +353,9 @@ FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, Sc
     auto start = Clock::now();
     assets->groom = loadGroom(scene);
     assets->surfaces = loadSurfaces(scene);
+    const auto environmentStart = Clock::now();
+    assets->environment = loadEnvironment(scene);
+    assets->environmentLoadSeconds = secondsSince(environmentStart);
     assets->times.load = secondsSince(start);
     throwIfInterrupted();
 
@@ -354,8 +377,8 @@ FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, Sc
         }
     }
     if (reuse) {
-        out.modelKey =
-            detail::modelKey(groom, out.gridKey, scene, options, assets->groom, assets->surfaces);
+        out.modelKey = detail::modelKey(groom, out.gridKey, scene, options, assets->groom,
+                                        assets->surfaces, assets->environment.get());
         if (reuse->assets && reuse->modelKey == out.modelKey) {
             // The same groom, surfaces, grid and model: the frame before's.
             out.reused = reuse->assets.get();
@@ -384,25 +407,31 @@ FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, Sc
     GridOptions gridOptions = options.grid;
     if (scene.fiberSampleSpacing)
         gridOptions.fiberSampleSpacing = *scene.fiberSampleSpacing;
-    switch (scene.globalTermMode) {
-    case GlobalTermMode::Exact: {
-        ExactOptions exact;
-        exact.rays = static_cast<int>(scene.exact.rays);
-        exact.radius = scene.exact.radius;
-        exact.seed = scene.exact.seed;
-        assets->globalTerm =
-            makeExactModel(assets->groom.groom, std::move(crossings), settings, exact);
-        break;
+    ExactOptions exact;
+    exact.rays = static_cast<int>(scene.exact.rays);
+    exact.radius = scene.exact.radius;
+    exact.seed = scene.exact.seed;
+    const auto makeModel = [&](CrossingTables tables, const GlobalTermSettings& s,
+                               const GridOptions& grid) -> std::unique_ptr<GlobalTermModel> {
+        switch (scene.globalTermMode) {
+        case GlobalTermMode::Exact:
+            return makeExactModel(assets->groom.groom, std::move(tables), s, exact);
+        case GlobalTermMode::Grid: return makeGridModel(*assets->grid, std::move(tables), s, grid);
+        case GlobalTermMode::Approx:
+            return makeApproxModel(*assets->grid, std::move(tables), s, grid);
+        }
+        throw std::logic_error("unknown global-term mode");
+    };
+    if (assets->environment) {
+        // The environment's regions: coarser spacings, no surfaces' shadow.
+        GlobalTermSettings open = settings;
+        open.surfaces = nullptr;
+        GridOptions grid = gridOptions;
+        grid.cacheSpacing = options.environment.cacheSpacing;
+        grid.fiberSampleSpacing = options.environment.fiberSampleSpacing;
+        assets->environmentTerm = makeModel(crossings, open, grid);
     }
-    case GlobalTermMode::Grid:
-        assets->globalTerm =
-            makeGridModel(*assets->grid, std::move(crossings), settings, gridOptions);
-        break;
-    case GlobalTermMode::Approx:
-        assets->globalTerm =
-            makeApproxModel(*assets->grid, std::move(crossings), settings, gridOptions);
-        break;
-    }
+    assets->globalTerm = makeModel(std::move(crossings), settings, gridOptions);
     assets->times.globalTerm = secondsSince(start);
     return out;
 }
@@ -451,14 +480,41 @@ SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& opti
     // all of theirs at once.
     // With reuse, a light prepared for the frame before under the same model
     // is taken as it is.
+    // The environment's regions are lights too (environment_lights.h), of
+    // their own model, after the scene's.
+    std::optional<detail::EnvironmentLighting> environment;
+    if (assets->environment) {
+        const auto start = Clock::now();
+        environment = detail::environmentLighting(
+            *assets->environment, scene.environment->name, scene.environmentLights,
+            options.environment.split, options.environment.surfaceSubdivisions);
+        EnvironmentReport& report = result.environment.emplace();
+        report.splitSeconds = secondsSince(start);
+        report.lights = environment->lights.size();
+        report.split = options.environment.split;
+        for (const EnvironmentRegion& region : environment->regions)
+            report.widestSpreadDegrees =
+                std::max(report.widestSpreadDegrees, degrees(std::sqrt(region.spread2)));
+        if (!options.environment.spread)
+            std::fill(environment->spread2.begin(), environment->spread2.end(), 0.0f);
+        result.times.globalTerm += report.splitSeconds;
+    }
     const std::size_t lightCount = scene.lights.size();
-    std::vector<std::shared_ptr<const LightGlobalTerm>> terms(lightCount);
-    std::vector<std::uint64_t> lightKeys(lightCount);
+    const std::size_t environmentCount = environment ? environment->lights.size() : 0;
+    std::vector<std::shared_ptr<const LightGlobalTerm>> terms(lightCount),
+        environmentTerms(environmentCount);
+    std::vector<std::uint64_t> lightKeys(lightCount), environmentKeys(environmentCount);
     if (reuse) { // the frame before's lights this frame does not have are freed first
         for (std::size_t l = 0; l < lightCount; ++l)
             lightKeys[l] = detail::lightKey(frame.modelKey, scene.lights[l]);
+        const std::uint64_t environmentModel =
+            Hasher().value(frame.modelKey).string("environment").digest();
+        for (std::size_t l = 0; l < environmentCount; ++l)
+            environmentKeys[l] = detail::lightKey(environmentModel, environment->lights[l]);
         std::erase_if(reuse->lights, [&](const auto& entry) {
-            return std::find(lightKeys.begin(), lightKeys.end(), entry.first) == lightKeys.end();
+            return std::find(lightKeys.begin(), lightKeys.end(), entry.first) == lightKeys.end() &&
+                   std::find(environmentKeys.begin(), environmentKeys.end(), entry.first) ==
+                       environmentKeys.end();
         });
     }
     result.lights.resize(lightCount);
@@ -490,6 +546,28 @@ SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& opti
         report.prepareSeconds = secondsSince(start);
     }
     workspace.reset(); // what no light keeps
+    if (environment) {
+        const auto start = Clock::now();
+        EnvironmentReport& report = *result.environment;
+        workspace = assets->environmentTerm->makeWorkspace();
+        for (std::size_t l = 0; l < environmentCount; ++l) {
+            if (environment->lights[l].isDark())
+                continue;
+            if (reuse)
+                if (const auto it = reuse->lights.find(environmentKeys[l]);
+                    it != reuse->lights.end()) {
+                    environmentTerms[l] = it->second;
+                    ++report.reusedLights;
+                }
+            if (!environmentTerms[l])
+                environmentTerms[l] =
+                    assets->environmentTerm->forLight(environment->lights[l], workspace.get());
+            report.heldBytes += environmentTerms[l]->memoryBytes();
+        }
+        workspace.reset();
+        report.prepareSeconds = secondsSince(start);
+        report.heldBytes += environment->surfaces.memoryBytes();
+    }
     result.globalTermPrepareSeconds = secondsSince(prepareStart);
     result.times.globalTerm += result.globalTermPrepareSeconds;
     if (reuse) { // this frame's lights, for the next (the others' caches are freed)
@@ -497,6 +575,9 @@ SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& opti
         for (std::size_t l = 0; l < lightCount; ++l)
             if (terms[l])
                 reuse->lights.emplace(lightKeys[l], terms[l]);
+        for (std::size_t l = 0; l < environmentCount; ++l)
+            if (environmentTerms[l])
+                reuse->lights.emplace(environmentKeys[l], environmentTerms[l]);
     }
 
     // The surfaces as the camera sees them, lit through the hair.
@@ -507,10 +588,33 @@ SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& opti
         std::vector<const LightGlobalTerm*> lightTerms;
         for (const auto& t : terms)
             lightTerms.push_back(t.get());
+        detail::SurfaceEnvironment seen;
+        if (environment) {
+            seen.irradiance = &environment->surfaces;
+            seen.lights = environment->lights;
+            for (const auto& t : environmentTerms)
+                seen.terms.push_back(t.get());
+        }
         surfaces = detail::surfaceLayer(*assets->surfaces.scene, assets->surfaces.albedo, camera,
-                                        scene.lights, lightTerms);
+                                        scene.lights, lightTerms, environment ? &seen : nullptr);
     }
+    BackgroundLayer background;
+    if (assets->environment && scene.environment->visible)
+        background = detail::backgroundLayer(*assets->environment, camera);
     const double surfaceSeconds = secondsSince(surfacesStart);
+
+    // The hair's view of a region: shadowed by the surfaces along its direction.
+    detail::ShadedEnvironment shadedEnvironment;
+    if (environment) {
+        shadedEnvironment.lights = environment->lights;
+        shadedEnvironment.spread2 = environment->spread2;
+        for (std::size_t l = 0; l < environmentCount; ++l)
+            shadedEnvironment.terms.push_back(
+                environmentTerms[l] ? withSurfaces(std::make_unique<detail::SharedGlobalTerm>(
+                                                       environmentTerms[l]),
+                                                   assets->surfaces.scene, environment->lights[l])
+                                    : nullptr);
+    }
 
     // One shader per fiber type (the shaders refer to their bcsdf and tables).
     const SceneGroom& groom = assets->groom;
@@ -519,9 +623,10 @@ SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& opti
     for (std::size_t t = 0; t < bcsdfs.size(); ++t)
         shaders.emplace_back(bcsdfs[t], assets->tables[t], scene.dualScattering);
     const detail::DualScatteringFragmentShader fragmentShader(
-        std::move(shaders), groom.groom.fiberType, scene.lights, std::move(terms));
+        std::move(shaders), groom.groom.fiberType, scene.lights, std::move(terms),
+        std::move(shadedEnvironment));
     RasterOutput image = rasterize(groom.groom, camera, fragmentShader,
-                                   rasterSettings(scene, options), surfaces);
+                                   rasterSettings(scene, options), surfaces, background);
     result.film = std::move(image.film);
     result.raster = image.stats;
     result.fiberTypes = groom.palette.size();
@@ -547,6 +652,11 @@ SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& opti
     const std::vector<GlobalTermStats> stats = fragmentShader.stats();
     for (std::size_t l = 0; l < stats.size(); ++l)
         result.lights[l].stats = stats[l];
+    if (result.environment) {
+        describeEnvironment(*assets->environment, scene, *result.environment);
+        result.environment->loadSeconds = assets->environmentLoadSeconds;
+        result.environment->stats = fragmentShader.environmentStats();
+    }
 
     if (writeFiles) {
         const auto start = Clock::now();
@@ -570,7 +680,12 @@ SceneRender renderPathTraced(const Scene& scene, const PipelineOptions& options,
     const SceneSurfaces surfaces = loadSurfaces(scene);
     for (const std::string& w : surfaces.warnings)
         result.warnings.push_back(w);
+    const auto environmentStart = Clock::now();
     const std::shared_ptr<const EnvironmentMap> environment = loadEnvironment(scene);
+    if (environment) {
+        describeEnvironment(*environment, scene, result.environment.emplace());
+        result.environment->loadSeconds = secondsSince(environmentStart);
+    }
     result.times.load = secondsSince(start);
     const std::string hash = pathTraceHash(scene, sceneGroom, surfaces, environment.get());
 
@@ -803,9 +918,28 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
     std::string written;
     for (const auto& p : r.written)
         written += (written.empty() ? "" : ", ") + p.string();
+    const auto megabytes = [](std::uint64_t bytes) {
+        return (bytes + 500'000) / 1'000'000;
+    };
+    // The environment map: what was read, and what reading it folded away.
+    const auto environmentMap = [&]() {
+        const EnvironmentReport& e = *r.environment;
+        std::string text = strCat("environment: ", e.source, ", ", e.width, "x", e.height, ", ",
+                                  megabytes(e.mapBytes), " MB with its distribution, ",
+                                  int(std::lround(1000 * e.loadSeconds)), " ms to read",
+                                  e.visible ? "; seen behind everything" : "; not seen");
+        if (e.folds.values > 0)
+            text += strCat("; ", thousands(e.folds.values),
+                           " negative values (a lossy codec's ringing, as low as ", e.folds.lowest,
+                           ") folded into the light within ", e.folds.radius,
+                           " pixels around them (", 100 * e.folds.energy, "% of the energy)");
+        more(text);
+    };
     if (r.pathTrace) {
         const PathTraceStats& pt = *r.pathTrace;
         row("load", r.times.load, "the groom");
+        if (r.environment)
+            environmentMap();
         std::snprintf(
             line, sizeof(line),
             "%u spp (%u this run%s); %s paths, %s rays + %s shadow rays: %.2f M rays/s, "
@@ -820,6 +954,12 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
                       thousands(pt.pathsAtDepthCap).c_str(), scene.pathTrace.maxDepth,
                       pt.energyAtDepthCap);
         more(line);
+        if (r.environment)
+            more(strCat("environment: importance-sampled by luminance x sin(theta) at every "
+                        "scattering event (",
+                        thousands(pt.environmentShadowRays), " of the shadow rays), ",
+                        thousands(pt.escapedRays),
+                        " continuation rays escaped to it; both weighted by the power heuristic"));
         row("write", r.times.write, written.empty() ? "nothing" : written);
         return;
     }
@@ -829,6 +969,8 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
             (r.surfaceTriangles > 0 ? ", " + thousands(r.surfaceTriangles) + " triangles" : ""));
     for (const std::string& note : r.groomNotes)
         more(note);
+    if (r.environment)
+        environmentMap();
     if (r.voxelSize > 0) {
         std::snprintf(line, sizeof(line), "%s active voxels of %.3g%s",
                       thousands(r.activeVoxels).c_str(), r.voxelSize,
@@ -840,9 +982,6 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
     }
     row("tables", r.times.tables,
         strCat("dual-scattering tables (disk cache), ", r.fiberTypes, " fiber type(s)"));
-    const auto megabytes = [](std::uint64_t bytes) {
-        return (bytes + 500'000) / 1'000'000;
-    };
     std::uint64_t queries = 0, evaluated = 0, blocked = 0, empty = 0, skippedLights = 0, held = 0;
     for (const LightReport& l : r.lights) {
         held += l.heldBytes;
@@ -876,6 +1015,17 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
         std::snprintf(line, sizeof(line), "%.3f s preparing the lights (one after another: ",
                       r.globalTermPrepareSeconds);
         more(line + prepared + "); the rest: lookups while shading");
+    }
+    if (r.environment) {
+        const EnvironmentReport& e = *r.environment;
+        more(strCat("environment: ", e.lights, " regions by median cut of ",
+                    kEnvironmentSplitNames.name(e.split), " (", int(std::lround(1000 * e.splitSeconds)),
+                    " ms, the widest ", std::lround(e.widestSpreadDegrees),
+                    " deg across), each a light: ", e.prepareSeconds, " s preparing them",
+                    e.reusedLights > 0 ? strCat(" (", e.reusedLights, " the frame before's)")
+                                       : std::string(),
+                    ", ", thousands(e.stats.queries), " hair queries (", thousands(e.stats.evaluated),
+                    " evaluated), ", megabytes(e.heldBytes), " MB held"));
     }
     row("raster", r.times.raster,
         thousands(st.fragments) + " fragments; skipped: " + thousands(st.segmentsOutsideView) +

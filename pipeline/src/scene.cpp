@@ -41,6 +41,7 @@ constexpr Range kDegrees{-360.0, 360.0};
 constexpr Range kAny{-1e30, 1e30};
 constexpr Range kMeshScale{-1e6, 1e6};
 constexpr std::size_t kMaxLightNameLength = 32;
+constexpr std::uint32_t kMaxEnvironmentLights = 1024;
 constexpr std::uintmax_t kMaxSceneFileBytes = 16u << 20;
 
 /// Calls `check` (an owner's validate()) and re-throws its InputError under
@@ -207,8 +208,8 @@ void parseFiber(JsonObject obj, Scene& scene) {
     obj.finish();
 }
 
-DualScatteringParams parseDualScattering(JsonObject obj) {
-    DualScatteringParams d;
+void parseDualScattering(JsonObject obj, Scene& scene) {
+    DualScatteringParams& d = scene.dualScattering;
     for (const char* key : {"d_f", "d_b"}) {
         const JsonValue v = obj[key];
         if (!v.present())
@@ -216,8 +217,10 @@ DualScatteringParams parseDualScattering(JsonObject obj) {
         (key[2] == 'f' ? d.d_f : d.d_b) = v.numberF(kAny);
         checkAt(v, [&] { d.validate(); });
     }
+    if (const JsonValue v = obj["environment_lights"]; v.present())
+        scene.environmentLights =
+            static_cast<std::uint32_t>(v.integer(1, kMaxEnvironmentLights));
     obj.finish();
-    return d;
 }
 
 // --- lights, camera, head ----------------------------------------------------
@@ -431,6 +434,9 @@ void Scene::validate() const {
         requireInRange("environment.intensity", e.intensity, kLightIntensity);
         requireInRange("environment.rotation", e.rotation, kDegrees);
     }
+    if (environmentLights < 1 || environmentLights > kMaxEnvironmentLights)
+        throw InputError(strCat("dual_scattering.environment_lights = ", environmentLights,
+                                ": expected an integer in [1, ", kMaxEnvironmentLights, "]"));
 
     const Camera cam(camera); // checks the frame, field of view and resolution
     if (head) {
@@ -521,7 +527,7 @@ Scene parseScene(const nlohmann::json& document, const std::string& sourceName,
     if (const JsonValue v = root["fiber"]; v.present())
         parseFiber(v.object(), scene);
     if (const JsonValue v = root["dual_scattering"]; v.present())
-        scene.dualScattering = parseDualScattering(v.object());
+        parseDualScattering(v.object(), scene);
 
     const JsonValue lights = root.required("lights", "an array of lights");
     std::vector<std::string> names; // in the file's order, the environment's too

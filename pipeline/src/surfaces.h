@@ -17,8 +17,11 @@
 // with V and T_s the light's global term at the point (transmittance/: the
 // hair's shadow — unscattered and forward-scattered light — and the other
 // surfaces' shadow, withSurfaces()), queried a surfaceOffset() off the surface
-// as a point on no fiber.
+// as a point on no fiber; and the environment's regions the same way, each
+// with the share of its light above the surface (SurfaceEnvironment).
 #pragma once
+
+#include "environment_lights.h"
 
 #include <hairvox/core/rgb.h>
 #include <hairvox/geometry/camera.h>
@@ -31,10 +34,23 @@
 
 namespace hairvox::detail {
 
+/// The environment's regions as surfaces see them (environment_lights.h):
+/// region k's light over the normals, and its global term toward the
+/// region's direction without the surfaces' shadow (null: skipped) — a
+/// surface point is shadowed by the surfaces along D_k(n), one ray:
+///     L += (ρ/π) Σ_k E_k(n) · (V_k + T_s,k) · [nothing along D_k(n)].
+struct SurfaceEnvironment {
+    const RegionIrradiance* irradiance = nullptr;
+    std::vector<Light> lights; ///< per region: toward its direction
+    std::vector<const LightGlobalTerm*> terms;
+};
+
 /// `terms[l]` is light l's global term, or null for a light that is skipped;
-/// `albedo` has one entry per surface.
+/// `albedo` has one entry per surface; `environment` (null: none) the
+/// environment's regions.
 SurfaceLayer surfaceLayer(const SurfaceScene& surfaces, const std::vector<Rgb>& albedo,
                           const Camera& camera, const std::vector<Light>& lights,
-                          const std::vector<const LightGlobalTerm*>& terms);
+                          const std::vector<const LightGlobalTerm*>& terms,
+                          const SurfaceEnvironment* environment = nullptr);
 
 } // namespace hairvox::detail

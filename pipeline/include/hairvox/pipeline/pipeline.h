@@ -11,6 +11,7 @@
 // same way.
 #pragma once
 
+#include <hairvox/core/hash.h>
 #include <hairvox/film/image_compare.h>
 #include <hairvox/geometry/environment_map.h>
 #include <hairvox/pathtrace/path_tracer.h>
@@ -33,11 +34,35 @@
 
 namespace hairvox {
 
+/// How the dual-scattering integrator lights with an environment
+/// (docs/environment.md, where each default is measured against the path
+/// tracer). The number of regions is the scene's (Scene::environmentLights).
+struct EnvironmentOptions {
+    /// What the median cut weighs: energy (the default), or solid angle (the
+    /// baseline of uniform directions).
+    EnvironmentSplit split = EnvironmentSplit::Energy;
+    /// The regions' lights in the grid modes: voxels between their caches'
+    /// shadow lines (GridOptions::cacheSpacing) and between their samples
+    /// along the fibers (GridOptions::fiberSampleSpacing). An area of the
+    /// sky casts softer shadows than a directional light.
+    float cacheSpacing = 3.0f;
+    float fiberSampleSpacing = 2.0f;
+    /// Sub-regions a region is cut into for what surfaces see of it
+    /// (environment_lights.h RegionIrradiance).
+    std::size_t surfaceSubdivisions = 16;
+    /// Widen the fiber's lobes by each region's angular spread; false: every
+    /// region a directional light.
+    bool spread = true;
+
+    void hashInto(Hasher& hasher) const;
+};
+
 struct PipelineOptions {
     int threads = 0;       ///< 0: all cores
     bool progress = false; ///< progress bars on stderr (the caller checks for a terminal)
     std::filesystem::path tableCacheDir; ///< empty: defaultTableCacheDir()
     GridOptions grid; ///< settings of the grid and approx modes (measured defaults)
+    EnvironmentOptions environment; ///< of an environment light, dual scattering
     /// Path tracing: add samples to the scene's own EXR output when it exists
     /// (InputError if it was rendered from another scene or seed).
     bool continuePathTrace = false;
@@ -139,7 +164,14 @@ struct SceneAssets {
     std::shared_ptr<const FiberGrid> grid;
     std::vector<DualScatteringTables> tables;    ///< per fiber type (groom.palette)
     std::unique_ptr<GlobalTermModel> globalTerm; ///< refers to `grid`: keep the assets together
-    StageTimes times;                            ///< load, voxelize, tables
+    /// The environment light's map (null: none) and the model of its
+    /// regions' global terms: the scene's mode with EnvironmentOptions'
+    /// spacings and without the surfaces' shadow (their rays are cast
+    /// along what each point sees of a region, environment_lights.h).
+    std::shared_ptr<const EnvironmentMap> environment;
+    std::unique_ptr<GlobalTermModel> environmentTerm;
+    double environmentLoadSeconds = 0; ///< of times.load
+    StageTimes times; ///< load, voxelize, tables
 };
 
 /// Loads or generates the scene's groom and builds what its global-term mode needs.
@@ -162,6 +194,25 @@ struct LightReport {
     GlobalTermStats stats;
 };
 
+/// What the environment light cost and how it was sampled.
+struct EnvironmentReport {
+    std::string source; ///< the file, or "uniform"
+    int width = 0, height = 0;
+    std::size_t mapBytes = 0;   ///< the map with its sampling distribution
+    EnvironmentMap::NegativeFolds folds;
+    double loadSeconds = 0;     ///< reading it and building its distribution
+    bool visible = false;
+    // Dual scattering: the regions as lights.
+    std::size_t lights = 0;     ///< regions lit with
+    EnvironmentSplit split = EnvironmentSplit::Energy;
+    float widestSpreadDegrees = 0; ///< the largest region's √spread2
+    double splitSeconds = 0;    ///< the median cut and the surfaces' table
+    double prepareSeconds = 0;  ///< the regions' global terms (one after another)
+    std::size_t reusedLights = 0; ///< prepared for the frame before
+    std::size_t heldBytes = 0;  ///< their caches
+    GlobalTermStats stats;      ///< the hair's queries toward the regions
+};
+
 struct SceneRender {
     Film film;
     std::optional<RasterStats> raster;       ///< the dual-scattering integrator's
@@ -169,6 +220,7 @@ struct SceneRender {
     std::vector<std::string> warnings;       ///< for the user (rejected shader results, ...)
     StageTimes times;
     std::vector<LightReport> lights;
+    std::optional<EnvironmentReport> environment; ///< when the scene has one
     /// Of times.globalTerm, the lights' preparation (wall time, the lights
     /// concurrently); the rest is the lookups made while shading.
     double globalTermPrepareSeconds = 0;

@@ -92,6 +92,9 @@ struct EnvironmentLight {
     bool visible = true;
 };
 
+/// Scene::environmentLights unless a scene says otherwise (docs/environment.md).
+inline constexpr std::uint32_t kDefaultEnvironmentLights = 16;
+
 /// Options of the `exact` global-term mode (DESIGN.md §5–6): K shadow rays per
 /// shading point from a disk of radius r perpendicular to the light.
 struct ExactSettings {
@@ -133,6 +136,9 @@ struct Scene {
     FiberScale fiberScale; ///< D (scene units: m for the procedural grooms) and k
     FiberParams fiber;
     DualScatteringParams dualScattering;
+    /// Regions of the environment map the dual-scattering integrator lights
+    /// with, each a light (docs/environment.md), [1, 1024].
+    std::uint32_t environmentLights = kDefaultEnvironmentLights;
     std::vector<Light> lights; ///< at most 16 (each adds per-light AOV layers)
     /// The environment light, if any (an entry of the scene file's "lights").
     std::optional<EnvironmentLight> environment;
