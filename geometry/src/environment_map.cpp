@@ -303,10 +303,20 @@ std::vector<EnvironmentRegion> EnvironmentMap::split(std::size_t count, Environm
     if (within.x0 < 0 || within.y0 < 0 || within.x1 > width_ || within.y1 > height_ ||
         within.x0 >= within.x1 || within.y0 >= within.y1)
         throw std::invalid_argument("EnvironmentMap::split: a region outside the map");
-    // Per row: its solid angle per pixel and its centre's direction inputs.
-    std::vector<double> dOmega(static_cast<std::size_t>(height_));
-    for (int j = 0; j < height_; ++j)
+    // Per row: its solid angle per pixel; the pixels' centres' directions in
+    // the map's frame (a rotation about +y keeps a region's spread).
+    std::vector<double> dOmega(static_cast<std::size_t>(height_)), sinTheta(dOmega.size()),
+        cosTheta(dOmega.size());
+    for (int j = 0; j < height_; ++j) {
         dOmega[std::size_t(j)] = pixelSolidAngle(j);
+        sinTheta[std::size_t(j)] = std::sin(Pi * (j + 0.5) / height_);
+        cosTheta[std::size_t(j)] = std::cos(Pi * (j + 0.5) / height_);
+    }
+    std::vector<double> sinPsi(static_cast<std::size_t>(width_)), cosPsi(sinPsi.size());
+    for (int i = 0; i < width_; ++i) {
+        sinPsi[std::size_t(i)] = std::sin(TwoPi * ((i + 0.5) / width_ - 0.5));
+        cosPsi[std::size_t(i)] = std::cos(TwoPi * ((i + 0.5) / width_ - 0.5));
+    }
     const auto weight = [&](int i, int j) {
         const double w = dOmega[std::size_t(j)];
         return by == EnvironmentSplit::Energy ? double((scale_ * pixel(i, j)).luminance()) * w : w;
@@ -314,23 +324,34 @@ std::vector<EnvironmentRegion> EnvironmentMap::split(std::size_t count, Environm
     struct Rect {
         int x0, y0, x1, y1;
         double weight;
+        double priority; ///< weight × spread about the mean direction
     };
     const auto weigh = [&](Rect& r) {
         r.weight = 0;
+        Vec3d moment(0.0);
         for (int j = r.y0; j < r.y1; ++j)
-            for (int i = r.x0; i < r.x1; ++i)
-                r.weight += weight(i, j);
+            for (int i = r.x0; i < r.x1; ++i) {
+                const double w = weight(i, j);
+                const auto sj = std::size_t(j), si = std::size_t(i);
+                r.weight += w;
+                moment += w * Vec3d(sinTheta[sj] * sinPsi[si], cosTheta[sj], -sinTheta[sj] * cosPsi[si]);
+            }
+        const double spread = r.weight > 0 ? std::max(0.0, 1.0 - glm::length(moment) / r.weight) : 0;
+        r.priority = r.weight * spread;
     };
-    std::vector<Rect> rects{{within.x0, within.y0, within.x1, within.y1, 0.0}};
+    std::vector<Rect> rects{{within.x0, within.y0, within.x1, within.y1, 0.0, 0.0}};
     weigh(rects[0]);
     std::vector<double> marginal;
     while (rects.size() < count) {
-        // The heaviest rectangle that can be cut (the first of equals).
+        // The rectangle whose point light would be most wrong: the largest
+        // weight × spread (its second moment about its mean direction), the
+        // first of equals. (By weight alone, a sun a few pixels wide would
+        // take a cut per halving of its rectangle, and the sky none.)
         std::size_t best = rects.size();
         for (std::size_t k = 0; k < rects.size(); ++k) {
             const Rect& r = rects[k];
-            if ((r.x1 - r.x0 > 1 || r.y1 - r.y0 > 1) && r.weight > 0 &&
-                (best == rects.size() || r.weight > rects[best].weight))
+            if ((r.x1 - r.x0 > 1 || r.y1 - r.y0 > 1) && r.priority > 0 &&
+                (best == rects.size() || r.priority > rects[best].priority))
                 best = k;
         }
         if (best == rects.size())

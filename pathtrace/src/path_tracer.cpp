@@ -170,6 +170,19 @@ public:
         // (per channel: the throughput then carries roulette's factor too).
         float continuationPdf = 0;
         LobeValues firstShare;
+        // The continuation escaped: the map's light, weighted against light
+        // sampling's density of the same direction.
+        const auto escaped = [&] {
+            ++counters.escaped;
+            const Rgb L = env_->radiance(dir) * powerHeuristic(continuationPdf, env_->pdf(dir));
+            if (firstOnHair && events == 1) {
+                out.add(kDirectR, throughput * L * firstShare.R);
+                out.add(kDirectTT, throughput * L * firstShare.TT);
+                out.add(kDirectTRT, throughput * L * firstShare.TRT);
+            } else {
+                out.add(firstOnHair ? kMultiple : kSurface, throughput * L);
+            }
+        };
         for (;;) {
             ++counters.rays;
             const std::optional<RayHit> hit = rays_.intersect(
@@ -180,18 +193,7 @@ public:
                                              ? scene_.environment->backdrop(dir)
                                              : scene_.background);
                 } else if (env_) {
-                    // The continuation escaped: the map's light, weighted
-                    // against light sampling's density of the same direction.
-                    ++counters.escaped;
-                    const Rgb L =
-                        env_->radiance(dir) * powerHeuristic(continuationPdf, env_->pdf(dir));
-                    if (firstOnHair && events == 1) {
-                        out.add(kDirectR, throughput * L * firstShare.R);
-                        out.add(kDirectTT, throughput * L * firstShare.TT);
-                        out.add(kDirectTRT, throughput * L * firstShare.TRT);
-                    } else {
-                        out.add(firstOnHair ? kMultiple : kSurface, throughput * L);
-                    }
+                    escaped();
                 }
                 break;
             }
@@ -319,6 +321,14 @@ public:
             if (events >= settings_.maxDepth) {
                 ++counters.atCap;
                 counters.energyAtCap += double(throughput.average());
+                // The environment seen by this last continuation is light of
+                // this path's depth, the other half of its sample's MIS weight.
+                if (env_) {
+                    ++counters.rays;
+                    if (!rays_.intersect(origin, dir, std::numeric_limits<float>::infinity(),
+                                         from ? &*from : nullptr))
+                        escaped();
+                }
                 break;
             }
             if (events >= settings_.rouletteDepth) {

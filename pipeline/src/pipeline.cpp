@@ -104,6 +104,18 @@ void warnIfNoHairSeen(const Scene& scene, bool hairSeen, const Groom* groom,
 
 } // namespace
 
+void EnvironmentOptions::validate() const {
+    if (!(cacheSpacing >= 0.5f && cacheSpacing <= 4.0f))
+        throw InputError(strCat("environment cache spacing = ", cacheSpacing,
+                                " voxels: expected a number in [0.5, 4]"));
+    if (!(fiberSampleSpacing >= 0.0f && fiberSampleSpacing <= 4.0f))
+        throw InputError(strCat("environment fiber sample spacing = ", fiberSampleSpacing,
+                                " voxels: expected a number in [0, 4]"));
+    if (surfaceSubdivisions < 1 || surfaceSubdivisions > 4096)
+        throw InputError(strCat("environment surface subdivisions = ", surfaceSubdivisions,
+                                ": expected an integer in [1, 4096]"));
+}
+
 void EnvironmentOptions::hashInto(Hasher& hasher) const {
     hasher.value(split).value(cacheSpacing).value(fiberSampleSpacing).value(surfaceSubdivisions);
     hasher.value(spread);
@@ -423,12 +435,14 @@ FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, Sc
         throw std::logic_error("unknown global-term mode");
     };
     if (assets->environment) {
-        // The environment's regions: coarser spacings, no surfaces' shadow.
+        // The environment's regions: a coarser cache, each query evaluated
+        // as it is (no surfaces' shadow, no samples along the fibers: the
+        // integrator adds both, environmentHairTerm()).
         GlobalTermSettings open = settings;
         open.surfaces = nullptr;
+        open.groom = nullptr;
         GridOptions grid = gridOptions;
         grid.cacheSpacing = options.environment.cacheSpacing;
-        grid.fiberSampleSpacing = options.environment.fiberSampleSpacing;
         assets->environmentTerm = makeModel(crossings, open, grid);
     }
     assets->globalTerm = makeModel(std::move(crossings), settings, gridOptions);
@@ -445,6 +459,24 @@ std::unique_ptr<SceneAssets> loadSceneAssets(const Scene& scene, const PipelineO
 }
 
 namespace {
+
+/// What the hair sees of an environment's region: its term shadowed by the
+/// surfaces along its direction, sampled along the fibers (grid and approx
+/// modes) every EnvironmentOptions::fiberSampleSpacing voxels — the
+/// surfaces' shadow too, which a directional light's keeps exact per point:
+/// a region of the sky casts a soft one, and a ray per fragment and region
+/// was a third of an environment-lit render's lookups.
+std::shared_ptr<const LightGlobalTerm> environmentHairTerm(
+    const SceneAssets& assets, std::shared_ptr<const LightGlobalTerm> term, const Light& light,
+    const PipelineOptions& options) {
+    std::unique_ptr<LightGlobalTerm> hair = withSurfaces(
+        std::make_unique<detail::SharedGlobalTerm>(std::move(term)), assets.surfaces.scene, light);
+    if (assets.grid && options.environment.fiberSampleSpacing > 0)
+        hair = alongFibers(std::move(hair), assets.groom.groom,
+                           options.environment.fiberSampleSpacing *
+                               static_cast<float>(assets.grid->info.voxelSize));
+    return hair;
+}
 
 SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& options,
                                  bool writeFiles, FrameReuse::State* reuse) {
@@ -610,9 +642,8 @@ SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& opti
         shadedEnvironment.spread2 = environment->spread2;
         for (std::size_t l = 0; l < environmentCount; ++l)
             shadedEnvironment.terms.push_back(
-                environmentTerms[l] ? withSurfaces(std::make_unique<detail::SharedGlobalTerm>(
-                                                       environmentTerms[l]),
-                                                   assets->surfaces.scene, environment->lights[l])
+                environmentTerms[l] ? environmentHairTerm(*assets, environmentTerms[l],
+                                                          environment->lights[l], options)
                                     : nullptr);
     }
 
@@ -756,6 +787,7 @@ SceneRender renderPathTraced(const Scene& scene, const PipelineOptions& options,
 SceneRender renderScene(const Scene& scene, const PipelineOptions& options, bool writeFiles,
                         FrameReuse* reuse) {
     scene.validate();
+    options.environment.validate();
     const std::uint64_t limit =
         options.maxMemoryBytes > 0 ? options.maxMemoryBytes : defaultMemoryLimit();
     const MemoryEstimate memory = estimateRenderMemory(scene);

@@ -232,16 +232,21 @@ TEST(EnvironmentMap, MedianCutPartitionsTheMapAndFindsTheSun) {
         for (int c = 0; c < 3; ++c)
             EXPECT_NEAR(sum[c], double(map.integral()[c]), 1e-4 * double(map.integral()[c]));
     }
-    // The sun (pixel (42, 16)) is a region of its own within the energy cut's 24.
+    // The sun (pixel (42, 16), 70% of the energy): the region holding it
+    // points at it, and the cuts still reach the whole sky — of 8 regions
+    // none spans a quarter of the sphere (cutting by weight alone spent six
+    // on the sun's rectangle and left a region of half the sky).
     const Vec3f sun = map.direction((42 + 0.5f) / 128.0f, (16 + 0.5f) / 64.0f);
-    bool found = false;
-    for (const EnvironmentRegion& r : map.split(24, EnvironmentSplit::Energy))
-        if (r.x1 - r.x0 == 1 && r.y1 - r.y0 == 1 && r.x0 == 42 && r.y0 == 16) {
-            found = true;
-            EXPECT_GT(glm::dot(r.direction, sun), std::cos(0.01f));
-            EXPECT_LT(r.spread2, 1e-4f);
+    int holders = 0;
+    for (const EnvironmentRegion& r : map.split(8, EnvironmentSplit::Energy)) {
+        EXPECT_LT(r.solidAngle, Pi) << r;
+        if (r.x0 <= 42 && 42 < r.x1 && r.y0 <= 16 && 16 < r.y1) {
+            ++holders;
+            EXPECT_GT(glm::dot(r.direction, sun), std::cos(radians(1.0f))) << r;
+            EXPECT_LT(r.spread2, 1e-2f) << r; // the sky around it, 4-5°
         }
-    EXPECT_TRUE(found);
+    }
+    EXPECT_EQ(holders, 1);
     const EnvironmentMap uniform = EnvironmentMap::uniform(Rgb(1.0f));
     for (const EnvironmentRegion& r : uniform.split(16, EnvironmentSplit::SolidAngle))
         EXPECT_NEAR(r.solidAngle, 4.0 * Pi / 16.0, 0.2 * 4.0 * Pi / 16.0);

@@ -34,15 +34,20 @@
 // exact (dω = 2π² sin θ du dv), so L/pdf is unbiased for any map.
 //
 // Splitting into lights (median cut, Debevec 2005, "A Median Cut Algorithm
-// for Light Probe Sampling"): the map's pixels are cut into rectangles of
-// equal weight — the rectangle of the largest weight is cut across its longer
-// side (its angular width measured at its rows' mean sin θ) where the weight
-// on either side is half — until there are the number asked for. Weight is
-// luminance × solid angle (energy: bright areas get many small regions), or
-// solid angle alone (equal areas: the baseline of K uniform directions). A
-// region stands for a directional light of irradiance ∫_region L dω from its
-// energy-weighted mean direction, with the angular spread of its energy about
-// that direction.
+// for Light Probe Sampling"): the map's pixels are cut into rectangles — a
+// rectangle is cut across its longer side (its angular width measured at its
+// rows' mean sin θ) where the weight on either side is half — until there are
+// the number asked for. Weight is luminance × solid angle (energy: bright
+// areas get many small regions), or solid angle alone (equal areas: the
+// baseline of K uniform directions). Debevec cuts every rectangle each round;
+// here the rectangle cut next is the one whose weight × spread about its mean
+// direction (its second moment: what a point light standing for it gets
+// wrong) is largest — so a sun a few pixels wide is cut down to a few
+// degrees and the rest of the cuts go to the sky, where cutting by weight
+// alone spends one per halving of the sun's rectangle (fifteen for sky.exr)
+// and leaves the sky one or two. A region stands for a directional light of
+// irradiance ∫_region L dω from its energy-weighted mean direction, with the
+// angular spread of its energy about that direction.
 #pragma once
 
 #include <hairvox/core/distribution.h>

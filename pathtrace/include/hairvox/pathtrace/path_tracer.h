@@ -29,7 +29,10 @@
 // rays that meet nothing see its backdrop when it is visible, the background
 // colour otherwise. Escaped light is filed like a light's: by lobe at depth 1
 // on a fiber (the direct_* layers), in `multiple` deeper, in `surface` on a
-// path that began on a surface.
+// path that began on a surface. A path stopped by `maxDepth` still traces its
+// last continuation to the environment: that light is of the path's own
+// depth (the other strategy of its last event), so that maxDepth = 1 is
+// single scattering in full.
 //
 // Russian roulette from depth `rouletteDepth` on, with survival probability
 // min(1, max channel of the throughput): unbiased, and light hair (albedo ~0.6

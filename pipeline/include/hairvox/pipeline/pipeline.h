@@ -43,17 +43,20 @@ struct EnvironmentOptions {
     EnvironmentSplit split = EnvironmentSplit::Energy;
     /// The regions' lights in the grid modes: voxels between their caches'
     /// shadow lines (GridOptions::cacheSpacing) and between their samples
-    /// along the fibers (GridOptions::fiberSampleSpacing). An area of the
-    /// sky casts softer shadows than a directional light.
+    /// along the fibers (GridOptions::fiberSampleSpacing; the surfaces'
+    /// shadow on the hair is sampled there too). An area of the sky casts
+    /// softer shadows than a directional light. [0.5, 4] and [0, 4].
     float cacheSpacing = 3.0f;
     float fiberSampleSpacing = 2.0f;
     /// Sub-regions a region is cut into for what surfaces see of it
     /// (environment_lights.h RegionIrradiance).
-    std::size_t surfaceSubdivisions = 16;
+    std::size_t surfaceSubdivisions = 16; ///< [1, 4096]
     /// Widen the fiber's lobes by each region's angular spread; false: every
     /// region a directional light.
     bool spread = true;
 
+    /// InputError naming the option and its range.
+    void validate() const;
     void hashInto(Hasher& hasher) const;
 };
 
