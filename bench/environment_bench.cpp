@@ -19,6 +19,8 @@
 //               under its two directional lights
 //   noise       the path tracer's noise floor under sky.exr against
 //               city.exr at equal time
+//   regions     what the regions cost at 1024² (K, spacings): wall and CPU
+//               time, preparation, lookups, shading, in this process
 //   cost        the default scene at 1024², grid mode: lit by studio.exr
 //               against its two directional lights — wall time and peak
 //               memory of the hairvox CLI, paired runs in child processes
@@ -320,7 +322,7 @@ void design(const Options& o) {
 
 void ratboy(const Options& o) {
     std::printf("\n## A real groom on its body: Ratboy's mohawk under studio.exr\n\n");
-    const std::uint32_t size = o.quick ? 160 : 320, spp = o.quick ? 64 : 1024;
+    const std::uint32_t size = o.quick ? 160 : 320, spp = o.quick ? 64 : 512;
     constexpr int kBlock = 8;
     const auto prepare = [&](const char* file) {
         Scene s = loadScene(kData / "scenes" / file);
@@ -381,6 +383,56 @@ void noise(const Options& o) {
         std::fflush(stdout);
     }
     std::printf("sky / city: %.2f (goal: within 2)\n", floors[1] / floors[0]);
+}
+
+// --- regions: what each costs ----------------------------------------------------
+
+double cpuSeconds() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+           1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+void regions(const Options& o) {
+    std::printf("\n## What the regions cost (dual scattering, grid mode)\n\n");
+    Scene base = defaultScene();
+    const std::uint32_t size = o.quick ? 512 : 1024;
+    base.camera.width = base.camera.height = size;
+    std::printf("the default scene at %ux%u, in this process (CPU seconds: the machine may be "
+                "shared); global term = the regions' preparation and lookups\n\n",
+                size, size);
+    std::printf("%-34s %9s %9s %9s %9s %9s\n", "lighting", "wall s", "CPU s", "prepare",
+                "lookups", "shade");
+    const auto row = [&](const std::string& label, const Scene& scene, const PipelineOptions& options) {
+        const double cpu = cpuSeconds();
+        const Rendered r = renderDual(scene, options);
+        const double prepare = r.render.environment ? r.render.environment->prepareSeconds +
+                                                          r.render.environment->splitSeconds
+                                                    : r.render.globalTermPrepareSeconds;
+        std::printf("%-34s %9.2f %9.2f %9.2f %9.2f %9.2f\n", label.c_str(), r.seconds,
+                    cpuSeconds() - cpu, prepare, r.render.times.globalTerm - prepare,
+                    r.render.times.shade);
+        std::fflush(stdout);
+    };
+    row("its two directional lights", base, PipelineOptions{});
+    for (const std::uint32_t k : {8u, 16u, 24u, 32u}) {
+        Scene s = withEnvironment(base, "studio.exr");
+        s.environmentLights = k;
+        row("studio.exr, K = " + std::to_string(k), s, PipelineOptions{});
+    }
+    for (const float spacing : {3.0f, 4.0f}) {
+        Scene s = withEnvironment(base, "studio.exr");
+        PipelineOptions options;
+        options.environment.fiberSampleSpacing = spacing;
+        row("studio.exr, K = 16, samples " + std::to_string(int(spacing)) + " voxels", s, options);
+    }
+    {
+        Scene s = withEnvironment(base, "studio.exr");
+        PipelineOptions options;
+        options.environment.cacheSpacing = 4.0f;
+        row("studio.exr, K = 16, cache lines 4", s, options);
+    }
 }
 
 // --- cost ------------------------------------------------------------------------
@@ -476,10 +528,11 @@ int main(int argc, char** argv) {
             o.out = argv[++i];
         else if (a == "--quick")
             o.quick = true;
-        else if (a == "identities" || a == "design" || a == "ratboy" || a == "noise" || a == "cost")
+        else if (a == "identities" || a == "design" || a == "ratboy" || a == "noise" || a == "cost" ||
+                 a == "regions")
             o.sections.insert(a);
         else {
-            std::fprintf(stderr, "usage: %s [--out DIR] [--quick] [identities|design|ratboy|noise|cost ...]\n",
+            std::fprintf(stderr, "usage: %s [--out DIR] [--quick] [identities|design|ratboy|noise|regions|cost ...]\n",
                          argv[0]);
             return 2;
         }
@@ -498,6 +551,8 @@ int main(int argc, char** argv) {
             ratboy(o);
         if (o.sections.count("noise"))
             noise(o);
+        if (o.sections.count("regions"))
+            regions(o);
         if (o.sections.count("cost"))
             cost(o);
     } catch (const std::exception& e) {

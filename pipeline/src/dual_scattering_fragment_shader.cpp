@@ -64,6 +64,8 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
     struct Scratch {
         std::vector<GlobalTermQuery> queries;
         std::vector<GlobalTerm> terms;
+        FiberSamplePlan plan;                ///< the environment's samples along the fibers
+        std::vector<GlobalTerm> sampleTerms; ///< at them
         std::vector<ShadeBatch> batches;                 ///< per fiber type
         std::vector<std::vector<std::uint32_t>> members; ///< per fiber type: its points
     };
@@ -74,6 +76,8 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
     std::vector<GlobalTerm>& terms = scratch->terms;
     std::vector<ShadeBatch>& batches = scratch->batches;
     std::vector<std::vector<std::uint32_t>>& members = scratch->members;
+    FiberSamplePlan& plan = scratch->plan;
+    std::vector<GlobalTerm>& sampleTerms = scratch->sampleTerms;
     queries.resize(points.size());
     for (std::size_t i = 0; i < points.size(); ++i)
         queries[i] = {points[i].position,
@@ -112,13 +116,27 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
     // The scene's lights, then the environment's (no AOVs of their own).
     const std::size_t environmentCount = environment_.lights.size();
     GlobalTermStats environmentStats;
+    const bool planned = environmentCount > 0 && environment_.groom && environment_.spacing > 0;
+    if (planned) {
+        const auto planStart = std::chrono::steady_clock::now();
+        plan.plan(queries, *environment_.groom, environment_.spacing);
+        sampleTerms.resize(plan.samples().size()); // every element written by evaluate
+        globalTermNanos += nanosSince(planStart);
+    }
     for (std::size_t l = 0; l < lightCount + environmentCount; ++l) {
         const bool ofEnvironment = l >= lightCount;
         const std::shared_ptr<const LightGlobalTerm>& term =
             ofEnvironment ? environment_.terms[l - lightCount] : terms_[l];
         if (term) {
             const auto evalStart = std::chrono::steady_clock::now();
-            (ofEnvironment ? environmentStats : batchStats[l]) += term->evaluate(queries, terms);
+            if (ofEnvironment && planned) {
+                GlobalTermStats stats = term->evaluate(plan.samples(), sampleTerms);
+                plan.interpolate(sampleTerms, terms);
+                stats.queries = points.size();
+                environmentStats += stats;
+            } else {
+                (ofEnvironment ? environmentStats : batchStats[l]) += term->evaluate(queries, terms);
+            }
             globalTermNanos += nanosSince(evalStart);
         } else {
             std::fill(terms.begin(), terms.end(), GlobalTerm::blocked());

@@ -30,10 +30,14 @@ ShaderLayout dualScatteringLayout(std::span<const Light> lights);
 
 /// The environment's regions as lights (environment_lights.h): each shaded
 /// with its angular spread, into the radiance layers only (no per-light AOVs).
+/// With a groom and a spacing, their terms are evaluated at samples along the
+/// fibers planned once for all of them (FiberSamplePlan) and interpolated.
 struct ShadedEnvironment {
     std::vector<Light> lights;
     std::vector<float> spread2; ///< per light (DualScatteringShader::shade)
     std::vector<std::shared_ptr<const LightGlobalTerm>> terms; ///< null: skipped
+    const Groom* groom = nullptr; ///< must outlive the shader
+    float spacing = 0;            ///< world units between samples along a fiber; 0: none
 };
 
 class DualScatteringFragmentShader final : public FragmentShader {

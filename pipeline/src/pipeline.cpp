@@ -460,23 +460,6 @@ std::unique_ptr<SceneAssets> loadSceneAssets(const Scene& scene, const PipelineO
 
 namespace {
 
-/// What the hair sees of an environment's region: its term shadowed by the
-/// surfaces along its direction, sampled along the fibers (grid and approx
-/// modes) every EnvironmentOptions::fiberSampleSpacing voxels — the
-/// surfaces' shadow too, which a directional light's keeps exact per point:
-/// a region of the sky casts a soft one, and a ray per fragment and region
-/// was a third of an environment-lit render's lookups.
-std::shared_ptr<const LightGlobalTerm> environmentHairTerm(
-    const SceneAssets& assets, std::shared_ptr<const LightGlobalTerm> term, const Light& light,
-    const PipelineOptions& options) {
-    std::unique_ptr<LightGlobalTerm> hair = withSurfaces(
-        std::make_unique<detail::SharedGlobalTerm>(std::move(term)), assets.surfaces.scene, light);
-    if (assets.grid && options.environment.fiberSampleSpacing > 0)
-        hair = alongFibers(std::move(hair), assets.groom.groom,
-                           options.environment.fiberSampleSpacing *
-                               static_cast<float>(assets.grid->info.voxelSize));
-    return hair;
-}
 
 SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& options,
                                  bool writeFiles, FrameReuse::State* reuse) {
@@ -635,16 +618,27 @@ SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& opti
         background = detail::backgroundLayer(*assets->environment, camera);
     const double surfaceSeconds = secondsSince(surfacesStart);
 
-    // The hair's view of a region: shadowed by the surfaces along its direction.
+    // The hair's view of a region: shadowed by the surfaces along its
+    // direction, sampled along the fibers (grid and approx modes) every
+    // EnvironmentOptions::fiberSampleSpacing voxels — the surfaces' shadow
+    // too, which a directional light's keeps exact per point: a region of
+    // the sky casts a soft one, and a ray per fragment and region was a
+    // third of an environment-lit render's lookups.
     detail::ShadedEnvironment shadedEnvironment;
     if (environment) {
         shadedEnvironment.lights = environment->lights;
         shadedEnvironment.spread2 = environment->spread2;
         for (std::size_t l = 0; l < environmentCount; ++l)
             shadedEnvironment.terms.push_back(
-                environmentTerms[l] ? environmentHairTerm(*assets, environmentTerms[l],
-                                                          environment->lights[l], options)
-                                    : nullptr);
+                environmentTerms[l]
+                    ? withSurfaces(std::make_unique<detail::SharedGlobalTerm>(environmentTerms[l]),
+                                   assets->surfaces.scene, environment->lights[l])
+                    : nullptr);
+        if (assets->grid) {
+            shadedEnvironment.groom = &assets->groom.groom;
+            shadedEnvironment.spacing = options.environment.fiberSampleSpacing *
+                                        static_cast<float>(assets->grid->info.voxelSize);
+        }
     }
 
     // One shader per fiber type (the shaders refer to their bcsdf and tables).

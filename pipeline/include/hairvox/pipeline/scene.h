@@ -93,7 +93,7 @@ struct EnvironmentLight {
 };
 
 /// Scene::environmentLights unless a scene says otherwise (docs/environment.md).
-inline constexpr std::uint32_t kDefaultEnvironmentLights = 16;
+inline constexpr std::uint32_t kDefaultEnvironmentLights = 8;
 
 /// Options of the `exact` global-term mode (DESIGN.md §5–6): K shadow rays per
 /// shading point from a disk of radius r perpendicular to the light.
