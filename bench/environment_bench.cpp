@@ -36,24 +36,23 @@
 
 #include <nlohmann/json.hpp>
 
-#include <fcntl.h>
-#include <sys/resource.h>
-#include <sys/wait.h>
-#include <spawn.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <fcntl.h>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iostream>
 #include <map>
 #include <set>
+#include <spawn.h>
 #include <string>
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <tuple>
+#include <unistd.h>
 #include <vector>
 
 extern char** environ;
@@ -279,7 +278,9 @@ void design(const Options& o) {
     variants.push_back({"solid angle", 16, [](EnvironmentOptions& e) {
                             e.split = EnvironmentSplit::SolidAngle;
                         }});
-    variants.push_back({"no spread", 16, [](EnvironmentOptions& e) { e.spread = false; }});
+    variants.push_back({"no spread", 16, [](EnvironmentOptions& e) {
+                            e.spread = false;
+                        }});
     variants.push_back({"lights' spacings 1.5, 1", 16, [](EnvironmentOptions& e) {
                             e.cacheSpacing = 1.5f;
                             e.fiberSampleSpacing = 1.0f;
@@ -402,9 +403,10 @@ void regions(const Options& o) {
     std::printf("the default scene at %ux%u, in this process (CPU seconds: the machine may be "
                 "shared); global term = the regions' preparation and lookups\n\n",
                 size, size);
-    std::printf("%-34s %9s %9s %9s %9s %9s\n", "lighting", "wall s", "CPU s", "prepare",
-                "lookups", "shade");
-    const auto row = [&](const std::string& label, const Scene& scene, const PipelineOptions& options) {
+    std::printf("%-34s %9s %9s %9s %9s %9s\n", "lighting", "wall s", "CPU s", "prepare", "lookups",
+                "shade");
+    const auto row = [&](const std::string& label, const Scene& scene,
+                         const PipelineOptions& options) {
         const double cpu = cpuSeconds();
         const Rendered r = renderDual(scene, options);
         const double prepare = r.render.environment ? r.render.environment->prepareSeconds +
@@ -479,13 +481,16 @@ void cost(const Options& o) {
     std::printf("\n## What an environment costs (dual scattering, grid mode)\n\n");
     nlohmann::json lights = nlohmann::json::parse(std::string(defaultSceneJson()));
     nlohmann::json studio = lights;
-    studio["lights"] = nlohmann::json::array(
-        {{{"name", "studio"}, {"type", "environment"}, {"file", (kData / "hdri" / "studio.exr").string()}}});
+    studio["lights"] =
+        nlohmann::json::array({{{"name", "studio"},
+                                {"type", "environment"},
+                                {"file", (kData / "hdri" / "studio.exr").string()}}});
     studio.erase("background");
     const int size = o.quick ? 512 : 1024;
     for (nlohmann::json* j : {&lights, &studio}) {
         (*j)["camera"]["resolution"] = {size, size};
-        (*j)["output"] = {{"exr", (o.out / "cost.exr").string()}, {"png", (o.out / "cost.png").string()}};
+        (*j)["output"] = {{"exr", (o.out / "cost.exr").string()},
+                          {"png", (o.out / "cost.png").string()}};
     }
     std::ofstream(o.out / "cost_lights.json") << lights.dump(1);
     std::ofstream(o.out / "cost_studio.json") << studio.dump(1);
@@ -497,7 +502,8 @@ void cost(const Options& o) {
     std::vector<double> t[2], peak[2], ratio;
     for (int p = 0; p < pairs; ++p)
         for (int k = 0; k < 2; ++k) {
-            const std::filesystem::path scene = o.out / (k == 0 ? "cost_lights.json" : "cost_studio.json");
+            const std::filesystem::path scene =
+                o.out / (k == 0 ? "cost_lights.json" : "cost_studio.json");
             const ChildRun r = runCli({"render", scene.string()},
                                       o.out / (k == 0 ? "cost_lights.log" : "cost_studio.log"));
             t[k].push_back(r.seconds);
@@ -507,8 +513,9 @@ void cost(const Options& o) {
         }
     std::printf("two directional lights  %6.2f s  %6.0f MiB peak\n", median(t[0]), median(peak[0]));
     std::printf("studio.exr              %6.2f s  %6.0f MiB peak\n", median(t[1]), median(peak[1]));
-    std::printf("ratio (median of the pairs' ratios) %.2f (goal: at most 2); peak under 1 GiB: %s\n",
-                median(ratio), median(peak[1]) < 1024 ? "yes" : "no");
+    std::printf(
+        "ratio (median of the pairs' ratios) %.2f (goal: at most 2); peak under 1 GiB: %s\n",
+        median(ratio), median(peak[1]) < 1024 ? "yes" : "no");
     std::printf("\nthe last environment-lit run's report:\n");
     std::ifstream log(o.out / "cost_studio.log");
     for (std::string line; std::getline(log, line);)
@@ -528,11 +535,13 @@ int main(int argc, char** argv) {
             o.out = argv[++i];
         else if (a == "--quick")
             o.quick = true;
-        else if (a == "identities" || a == "design" || a == "ratboy" || a == "noise" || a == "cost" ||
-                 a == "regions")
+        else if (a == "identities" || a == "design" || a == "ratboy" || a == "noise" ||
+                 a == "cost" || a == "regions")
             o.sections.insert(a);
         else {
-            std::fprintf(stderr, "usage: %s [--out DIR] [--quick] [identities|design|ratboy|noise|regions|cost ...]\n",
+            std::fprintf(stderr,
+                         "usage: %s [--out DIR] [--quick] "
+                         "[identities|design|ratboy|noise|regions|cost ...]\n",
                          argv[0]);
             return 2;
         }

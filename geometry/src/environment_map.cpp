@@ -334,9 +334,11 @@ std::vector<EnvironmentRegion> EnvironmentMap::split(std::size_t count, Environm
                 const double w = weight(i, j);
                 const auto sj = std::size_t(j), si = std::size_t(i);
                 r.weight += w;
-                moment += w * Vec3d(sinTheta[sj] * sinPsi[si], cosTheta[sj], -sinTheta[sj] * cosPsi[si]);
+                moment +=
+                    w * Vec3d(sinTheta[sj] * sinPsi[si], cosTheta[sj], -sinTheta[sj] * cosPsi[si]);
             }
-        const double spread = r.weight > 0 ? std::max(0.0, 1.0 - glm::length(moment) / r.weight) : 0;
+        const double spread =
+            r.weight > 0 ? std::max(0.0, 1.0 - glm::length(moment) / r.weight) : 0;
         r.priority = r.weight * spread;
     };
     std::vector<Rect> rects{{within.x0, within.y0, within.x1, within.y1, 0.0, 0.0}};

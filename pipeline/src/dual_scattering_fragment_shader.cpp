@@ -135,7 +135,8 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
                 stats.queries = points.size();
                 environmentStats += stats;
             } else {
-                (ofEnvironment ? environmentStats : batchStats[l]) += term->evaluate(queries, terms);
+                (ofEnvironment ? environmentStats : batchStats[l]) +=
+                    term->evaluate(queries, terms);
             }
             globalTermNanos += nanosSince(evalStart);
         } else {

@@ -36,8 +36,8 @@ struct ShadedEnvironment {
     std::vector<Light> lights;
     std::vector<float> spread2; ///< per light (DualScatteringShader::shade)
     std::vector<std::shared_ptr<const LightGlobalTerm>> terms; ///< null: skipped
-    const Groom* groom = nullptr; ///< must outlive the shader
-    float spacing = 0;            ///< world units between samples along a fiber; 0: none
+    const Groom* groom = nullptr;                              ///< must outlive the shader
+    float spacing = 0; ///< world units between samples along a fiber; 0: none
 };
 
 class DualScatteringFragmentShader final : public FragmentShader {

@@ -42,7 +42,8 @@ RegionIrradiance::RegionIrradiance(const EnvironmentMap& map,
                     if (!(cosine > 0))
                         continue;
                     irradiance += Rgbd(part.irradiance) * double(cosine);
-                    direction += double(part.irradiance.luminance() * cosine) * Vec3d(part.direction);
+                    direction +=
+                        double(part.irradiance.luminance() * cosine) * Vec3d(part.direction);
                 }
                 nodes[y * kNormalsX + x] = {Rgb(irradiance), Vec3f(direction)};
             }
@@ -57,9 +58,12 @@ RegionIrradiance::Value RegionIrradiance::at(std::size_t region, const Vec3f& n)
     const float fx = phi * float(kNormalsX / TwoPi), fy = theta * float((kNormalsY - 1) / Pi);
     const int x0 = std::min(int(fx), kNormalsX - 1), y0 = std::min(int(fy), kNormalsY - 2);
     const int x1 = (x0 + 1) % kNormalsX, y1 = y0 + 1;
-    const float tx = std::clamp(fx - float(x0), 0.0f, 1.0f), ty = std::clamp(fy - float(y0), 0.0f, 1.0f);
+    const float tx = std::clamp(fx - float(x0), 0.0f, 1.0f),
+                ty = std::clamp(fy - float(y0), 0.0f, 1.0f);
     const Node* nodes = table_.data() + region * std::size_t(kNormalsX * kNormalsY);
-    const auto node = [&](int x, int y) -> const Node& { return nodes[y * kNormalsX + x]; };
+    const auto node = [&](int x, int y) -> const Node& {
+        return nodes[y * kNormalsX + x];
+    };
     const float w00 = (1 - tx) * (1 - ty), w10 = tx * (1 - ty), w01 = (1 - tx) * ty, w11 = tx * ty;
     Value v;
     v.irradiance = w00 * node(x0, y0).irradiance + w10 * node(x1, y0).irradiance +

@@ -51,7 +51,7 @@ public:
                      std::size_t subdivisions);
 
     struct Value {
-        Rgb irradiance{0.0f};             ///< E_k(n)
+        Rgb irradiance{0.0f};              ///< E_k(n)
         Vec3f direction{0.0f, 1.0f, 0.0f}; ///< D_k(n), unit (meaningless where E_k is 0)
     };
     /// Region k's light on a surface of unit normal n.

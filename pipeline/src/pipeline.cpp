@@ -428,7 +428,8 @@ FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, Sc
         switch (scene.globalTermMode) {
         case GlobalTermMode::Exact:
             return makeExactModel(assets->groom.groom, std::move(tables), s, exact);
-        case GlobalTermMode::Grid: return makeGridModel(*assets->grid, std::move(tables), s, grid);
+        case GlobalTermMode::Grid:
+            return makeGridModel(*assets->grid, std::move(tables), s, grid);
         case GlobalTermMode::Approx:
             return makeApproxModel(*assets->grid, std::move(tables), s, grid);
         }
@@ -459,7 +460,6 @@ std::unique_ptr<SceneAssets> loadSceneAssets(const Scene& scene, const PipelineO
 }
 
 namespace {
-
 
 SceneRender renderDualScattering(const Scene& scene, const PipelineOptions& options,
                                  bool writeFiles, FrameReuse::State* reuse) {
@@ -954,11 +954,14 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
                                   megabytes(e.mapBytes), " MB with its distribution, ",
                                   int(std::lround(1000 * e.loadSeconds)), " ms to read",
                                   e.visible ? "; seen behind everything" : "; not seen");
-        if (e.folds.values > 0)
-            text += strCat("; ", thousands(e.folds.values),
-                           " negative values (a lossy codec's ringing, as low as ", e.folds.lowest,
-                           ") folded into the light within ", e.folds.radius,
-                           " pixels around them (", 100 * e.folds.energy, "% of the energy)");
+        if (e.folds.values > 0) {
+            std::snprintf(line, sizeof(line),
+                          "; %s negative values (a lossy codec's ringing, as low as %.4g) folded "
+                          "into the light within %d pixel(s) around them (%.2g%% of the energy)",
+                          thousands(e.folds.values).c_str(), double(e.folds.lowest), e.folds.radius,
+                          100 * e.folds.energy);
+            text += line;
+        }
         more(text);
     };
     if (r.pathTrace) {
@@ -1017,15 +1020,18 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
         empty += l.stats.emptyPaths;
         skippedLights += l.skipped ? 1 : 0;
     }
-    row("global term", r.times.globalTerm,
-        thousands(queries) + " queries" +
-            (evaluated < queries - blocked
-                 ? strCat(" (", thousands(evaluated),
-                          " evaluated, the rest interpolated along fibers)")
-                 : std::string()) +
-            "; skipped: " + thousands(skippedLights) + " light(s), " + thousands(blocked) +
-            " behind surfaces, " + thousands(empty) + " with nothing in front" +
-            (held > 0 ? strCat("; ", megabytes(held), " MB held") : std::string()));
+    if (r.lights.empty() && r.environment)
+        row("global term", r.times.globalTerm, "the environment's regions alone (below)");
+    else
+        row("global term", r.times.globalTerm,
+            thousands(queries) + " queries" +
+                (evaluated < queries - blocked
+                     ? strCat(" (", thousands(evaluated),
+                              " evaluated, the rest interpolated along fibers)")
+                     : std::string()) +
+                "; skipped: " + thousands(skippedLights) + " light(s), " + thousands(blocked) +
+                " behind surfaces, " + thousands(empty) + " with nothing in front" +
+                (held > 0 ? strCat("; ", megabytes(held), " MB held") : std::string()));
     // What each light's preparation (the grid modes' cache) took: the lights
     // are prepared one after another, so these add up to the stage's time.
     std::string prepared;
@@ -1044,14 +1050,17 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
     }
     if (r.environment) {
         const EnvironmentReport& e = *r.environment;
-        more(strCat("environment: ", e.lights, " regions by median cut of ",
-                    kEnvironmentSplitNames.name(e.split), " (", int(std::lround(1000 * e.splitSeconds)),
-                    " ms, the widest ", std::lround(e.widestSpreadDegrees),
-                    " deg across), each a light: ", e.prepareSeconds, " s preparing them",
-                    e.reusedLights > 0 ? strCat(" (", e.reusedLights, " the frame before's)")
-                                       : std::string(),
-                    ", ", thousands(e.stats.queries), " hair queries (", thousands(e.stats.evaluated),
-                    " evaluated), ", megabytes(e.heldBytes), " MB held"));
+        std::snprintf(
+            line, sizeof(line),
+            "environment: %zu regions by median cut of %s (%.0f ms; spread up to %.0f "
+            "deg), each a light: %.3f s preparing them%s, %s hair queries (%s "
+            "evaluated), %llu MB held",
+            e.lights, kEnvironmentSplitNames.name(e.split), 1000 * e.splitSeconds,
+            double(e.widestSpreadDegrees), e.prepareSeconds,
+            e.reusedLights > 0 ? strCat(" (", e.reusedLights, " the frame before's)").c_str() : "",
+            thousands(e.stats.queries).c_str(), thousands(e.stats.evaluated).c_str(),
+            static_cast<unsigned long long>(megabytes(e.heldBytes)));
+        more(line);
     }
     row("raster", r.times.raster,
         thousands(st.fragments) + " fragments; skipped: " + thousands(st.segmentsOutsideView) +

@@ -218,8 +218,7 @@ void parseDualScattering(JsonObject obj, Scene& scene) {
         checkAt(v, [&] { d.validate(); });
     }
     if (const JsonValue v = obj["environment_lights"]; v.present())
-        scene.environmentLights =
-            static_cast<std::uint32_t>(v.integer(1, kMaxEnvironmentLights));
+        scene.environmentLights = static_cast<std::uint32_t>(v.integer(1, kMaxEnvironmentLights));
     obj.finish();
 }
 

@@ -62,7 +62,9 @@ void writeMap(const std::filesystem::path& path, int width, int height,
 
 TEST(EnvironmentMap, LayoutPutsRowZeroUpAndTheMiddleColumnTowardMinusZ) {
     const EnvironmentMap map(64, randomPixels(64, 1, false), "test");
-    const auto near = [](const Vec3f& a, const Vec3f& b) { return glm::distance(a, b) < 1e-5f; };
+    const auto near = [](const Vec3f& a, const Vec3f& b) {
+        return glm::distance(a, b) < 1e-5f;
+    };
     EXPECT_TRUE(near(map.direction(0.5f, 0.5f), Vec3f(0, 0, -1)));
     EXPECT_TRUE(near(map.direction(0.75f, 0.5f), Vec3f(1, 0, 0)));
     EXPECT_TRUE(near(map.direction(0.25f, 0.5f), Vec3f(-1, 0, 0)));
@@ -71,7 +73,8 @@ TEST(EnvironmentMap, LayoutPutsRowZeroUpAndTheMiddleColumnTowardMinusZ) {
     EXPECT_TRUE(near(map.direction(0.3f, 1.0f), Vec3f(0, -1, 0)));
     // The pixel a direction falls in, and back.
     EXPECT_EQ(map.radiance(Vec3f(0, 0, -1)), map.pixel(32, 16));
-    EXPECT_EQ(map.radiance(Vec3f(0, 1, 0)), map.pixel(int(map.coordinates(Vec3f(0, 1, 0)).x * 64), 0));
+    EXPECT_EQ(map.radiance(Vec3f(0, 1, 0)),
+              map.pixel(int(map.coordinates(Vec3f(0, 1, 0)).x * 64), 0));
     Pcg32 rng(7);
     for (int k = 0; k < 1000; ++k) {
         const float u = rng.uniformFloat(), v = 0.01f + 0.98f * rng.uniformFloat();
@@ -89,13 +92,14 @@ TEST(EnvironmentMap, RotationByNinetyDegreesIsTheMapRolledByAQuarter) {
     std::vector<Rgb> rolled(pixels.size());
     for (int j = 0; j < height; ++j)
         for (int i = 0; i < width; ++i)
-            rolled[std::size_t(j * width + i)] = pixels[std::size_t(j * width + (i + width / 4) % width)];
+            rolled[std::size_t(j * width + i)] =
+                pixels[std::size_t(j * width + (i + width / 4) % width)];
     const EnvironmentMap rotated(width, pixels, "rotated", Rgb(1.0f), 90.0f);
     const EnvironmentMap roll(width, rolled, "rolled", Rgb(1.0f), 0.0f);
     for (int j = 0; j < height; ++j)
         for (int i = 0; i < width; ++i) {
-            const Vec3f omega = roll.direction((float(i) + 0.5f) / float(width),
-                                               (float(j) + 0.5f) / float(height));
+            const Vec3f omega =
+                roll.direction((float(i) + 0.5f) / float(width), (float(j) + 0.5f) / float(height));
             ASSERT_EQ(rotated.radiance(omega), roll.radiance(omega)) << i << ", " << j;
         }
     Pcg32 rng(11);
@@ -133,8 +137,8 @@ TEST(EnvironmentMap, SamplingPassesAChiSquareTestAgainstItsDensity) {
         for (int i = 0; i < width; ++i) {
             const float u = (float(i) + 0.5f) / float(width), v = (float(j) + 0.5f) / float(height);
             const double sinTheta = std::sin(Pi * double(v));
-            expected[std::size_t(j * width + i)] = double(map.pdf(map.direction(u, v))) * 2.0 *
-                                                   Pi * Pi * sinTheta / double(width * height);
+            expected[std::size_t(j * width + i)] = double(map.pdf(map.direction(u, v))) * 2.0 * Pi *
+                                                   Pi * sinTheta / double(width * height);
             total += expected[std::size_t(j * width + i)];
         }
     EXPECT_NEAR(total, 1.0, 1e-4); // the density integrates to one
@@ -167,7 +171,8 @@ TEST(EnvironmentMap, SamplingPassesAChiSquareTestAgainstItsDensity) {
         ++cells;
     }
     if (pooledExpected > 0) {
-        chi2 += (pooledObserved - pooledExpected) * (pooledObserved - pooledExpected) / pooledExpected;
+        chi2 +=
+            (pooledObserved - pooledExpected) * (pooledObserved - pooledExpected) / pooledExpected;
         ++cells;
     }
     ASSERT_GT(cells, 300);
@@ -199,7 +204,8 @@ TEST(EnvironmentMap, AUniformMapHasItsClosedFormIntegrals) {
     const EnvironmentMap map = EnvironmentMap::uniform(L);
     for (int c = 0; c < 3; ++c)
         EXPECT_NEAR(map.integral()[c], 4.0 * Pi * double(L[c]), 1e-4 * 4.0 * Pi * double(L[c]));
-    for (const Vec3f& n : {Vec3f(0, 1, 0), Vec3f(1, 0, 0), glm::normalize(Vec3f(0.3f, -0.5f, 0.8f))}) {
+    for (const Vec3f& n :
+         {Vec3f(0, 1, 0), Vec3f(1, 0, 0), glm::normalize(Vec3f(0.3f, -0.5f, 0.8f))}) {
         const Rgb e = map.irradiance(n);
         for (int c = 0; c < 3; ++c)
             EXPECT_NEAR(e[c], Pi * double(L[c]), 2e-3 * Pi * double(L[c])) << n;
@@ -258,7 +264,9 @@ TEST(EnvironmentMap, MedianCutPartitionsTheMapAndFindsTheSun) {
 TEST(EnvironmentMap, NegativeRingingIsFoldedWithItsEnergyKept) {
     const int width = 32;
     std::vector<Rgb> p(std::size_t(width * width / 2), Rgb(0.0f));
-    const auto at = [&](int i, int j) -> Rgb& { return p[std::size_t(j * width + i)]; };
+    const auto at = [&](int i, int j) -> Rgb& {
+        return p[std::size_t(j * width + i)];
+    };
     at(10, 8) = Rgb(100.0f, 50.0f, 10.0f);
     at(9, 8) = Rgb(-8.0f, -1.0f, 0.0f);
     at(11, 9) = Rgb(-5.0f, 0.0f, -2.0f);
@@ -267,8 +275,9 @@ TEST(EnvironmentMap, NegativeRingingIsFoldedWithItsEnergyKept) {
     const auto energy = [&](const std::vector<Rgb>& px) {
         Rgbd e(0.0);
         for (int j = 0; j < width / 2; ++j) {
-            const double dOmega = TwoPi / width *
-                                  (std::cos(Pi * j / (width / 2)) - std::cos(Pi * (j + 1) / (width / 2)));
+            const double dOmega =
+                TwoPi / width *
+                (std::cos(Pi * j / (width / 2)) - std::cos(Pi * (j + 1) / (width / 2)));
             for (int i = 0; i < width; ++i)
                 e += Rgbd(px[std::size_t(j * width + i)]) * dOmega;
         }

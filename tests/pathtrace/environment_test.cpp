@@ -33,7 +33,8 @@ std::shared_ptr<const EnvironmentMap> shippedMap(const char* name) {
 TEST(PathTracerEnvironment, PowerHeuristicWeightsSumToOne) {
     Pcg32 rng(3);
     for (int k = 0; k < 10000; ++k) {
-        const float a = std::exp(rng.uniform(-30.0f, 30.0f)), b = std::exp(rng.uniform(-30.0f, 30.0f));
+        const float a = std::exp(rng.uniform(-30.0f, 30.0f)),
+                    b = std::exp(rng.uniform(-30.0f, 30.0f));
         EXPECT_NEAR(powerHeuristic(a, b) + powerHeuristic(b, a), 1.0f, 1e-6f) << a << ", " << b;
         EXPECT_GE(powerHeuristic(a, b), 0.0f);
     }
@@ -60,9 +61,11 @@ TEST(PathTracerEnvironment, OneFiberSingleScatteringIsTheQuadratureOfTheMap) {
     std::vector<Rgb> pixels(std::size_t(width * width / 2));
     for (int j = 0; j < width / 2; ++j)
         for (int i = 0; i < width; ++i)
-            pixels[std::size_t(j * width + i)] = Rgb(0.2f + 0.05f * float(i % 7), 0.3f, 0.1f + 0.04f * float(j));
+            pixels[std::size_t(j * width + i)] =
+                Rgb(0.2f + 0.05f * float(i % 7), 0.3f, 0.1f + 0.04f * float(j));
     pixels[std::size_t(5 * width + 13)] = Rgb(400.0f, 300.0f, 200.0f); // a sun
-    const auto map = std::make_shared<const EnvironmentMap>(width, pixels, "test", Rgb(1.0f), 20.0f);
+    const auto map =
+        std::make_shared<const EnvironmentMap>(width, pixels, "test", Rgb(1.0f), 20.0f);
 
     PathTraceScene scene;
     scene.groom = &groom;
@@ -83,8 +86,8 @@ TEST(PathTracerEnvironment, OneFiberSingleScatteringIsTheQuadratureOfTheMap) {
     LobeValues expected;
     double got[3] = {0, 0, 0};
     for (int x = 0; x < size; ++x) {
-        const Vec3f d = camera.toWorldDirection(
-            camera.rayDirection(Vec2f(float(x) + 0.5f, float(row) + 0.5f)));
+        const Vec3f d =
+            camera.toWorldDirection(camera.rayDirection(Vec2f(float(x) + 0.5f, float(row) + 0.5f)));
         const Vec3f p = camera.position() + (-camera.position().y / d.y) * d;
         if (std::abs(p.x) > 0.09f)
             continue;
@@ -98,12 +101,14 @@ TEST(PathTracerEnvironment, OneFiberSingleScatteringIsTheQuadratureOfTheMap) {
                 for (int sj = 0; sj < kSub; ++sj) {
                     const double v0 = (j + double(sj) / kSub) / (width / 2),
                                  v1 = (j + double(sj + 1) / kSub) / (width / 2);
-                    const double dOmega = TwoPi / (width * kSub) *
-                                          (std::cos(Pi * v0) - std::cos(Pi * v1));
+                    const double dOmega =
+                        TwoPi / (width * kSub) * (std::cos(Pi * v0) - std::cos(Pi * v1));
                     for (int si = 0; si < kSub; ++si) {
-                        const Vec3f omega = map->direction(
-                            (float(k) + (float(si) + 0.5f) / kSub) / float(width), float(0.5 * (v0 + v1)));
-                        const FiberAngles fa = FiberAngles::fromDirections(omega, wo, Vec3f(1, 0, 0));
+                        const Vec3f omega =
+                            map->direction((float(k) + (float(si) + 0.5f) / kSub) / float(width),
+                                           float(0.5 * (v0 + v1)));
+                        const FiberAngles fa =
+                            FiberAngles::fromDirections(omega, wo, Vec3f(1, 0, 0));
                         const LobeValues f = bcsdf.eval(fa);
                         for (Lobe lobe : kLobes)
                             expected[lobe] += alpha * float(dOmega) * fa.cosTheta_i * (L * f[lobe]);
@@ -142,8 +147,8 @@ TEST(PathTracerEnvironment, AUniformEnvironmentOnALambertianSphereIsAlbedoTimesR
     scene.camera.position = Vec3f(0.0f, 0.1f, 0.6f);
     scene.camera.lookAt = Vec3f(0.0f);
     scene.camera.width = scene.camera.height = 48;
-    scene.surfaces = std::make_shared<const SurfaceScene>(
-        std::vector<Sphere>{{Vec3f(0.0f), 0.1f}}, std::vector<TriangleMesh>{});
+    scene.surfaces = std::make_shared<const SurfaceScene>(std::vector<Sphere>{{Vec3f(0.0f), 0.1f}},
+                                                          std::vector<TriangleMesh>{});
     scene.surfaceAlbedo = {Rgb(0.5f, 0.4f, 0.3f)};
     const Rgb L(0.8f, 1.0f, 1.2f);
     scene.environment = std::make_shared<const EnvironmentMap>(EnvironmentMap::uniform(L));

@@ -67,11 +67,13 @@ TEST(SceneEnvironment, KeysParse) {
 TEST(SceneEnvironment, BadKeysNameTheirPath) {
     nlohmann::json j = environmentScene();
     j["lights"].push_back({{"type", "environment"}, {"color", {1, 1, 1}}});
-    EXPECT_EQ(errorOf(j), "scene.json: /lights/2: a second environment light (the first is lights 1): "
-                          "a scene has at most one; combine the maps into one");
+    EXPECT_EQ(errorOf(j),
+              "scene.json: /lights/2: a second environment light (the first is lights 1): "
+              "a scene has at most one; combine the maps into one");
     j = environmentScene();
     j["lights"][1]["rotation"] = 400;
-    EXPECT_EQ(errorOf(j), "scene.json: /lights/1/rotation: expected a number in [-360, 360], got 400");
+    EXPECT_EQ(errorOf(j),
+              "scene.json: /lights/1/rotation: expected a number in [-360, 360], got 400");
     j = environmentScene();
     j["lights"][1]["samples"] = 4;
     EXPECT_TRUE(test::contains(errorOf(j), "/lights/1/samples: unknown key (valid keys in "
@@ -86,7 +88,8 @@ TEST(SceneEnvironment, BadKeysNameTheirPath) {
     EXPECT_TRUE(test::contains(errorOf(j), "lights 0 and 1 are both named \"sky\"")) << errorOf(j);
     j = environmentScene();
     j["dual_scattering"] = {{"environment_lights", 0}};
-    EXPECT_TRUE(test::contains(errorOf(j), "/dual_scattering/environment_lights: expected an integer"))
+    EXPECT_TRUE(
+        test::contains(errorOf(j), "/dual_scattering/environment_lights: expected an integer"))
         << errorOf(j);
     j = environmentScene();
     j["lights"][1]["intensity"] = -1;
@@ -123,7 +126,8 @@ TEST(PipelineEnvironment, AMissingMapIsAnErrorNamingTheLightAndTheFile) {
             renderScene(scene, options(dir), false);
             ADD_FAILURE() << "no error";
         } catch (const InputError& e) {
-            EXPECT_TRUE(test::contains(e.what(), "environment: environment light \"environment\": "));
+            EXPECT_TRUE(
+                test::contains(e.what(), "environment: environment light \"environment\": "));
             EXPECT_TRUE(test::contains(e.what(), "none.exr: cannot read OpenEXR file")) << e.what();
         }
     }
@@ -159,7 +163,8 @@ TEST(PipelineEnvironment, AUniformEnvironmentOnALambertianSphereIsAlbedoTimesRad
         const SceneRender r = renderScene(scene, options(dir), false);
         const Rgb got = meanSurface(r.film);
         for (int c = 0; c < 3; ++c)
-            EXPECT_NEAR(got[c], expected[c], 0.02f * expected[c]) << toString(integrator) << " " << c;
+            EXPECT_NEAR(got[c], expected[c], 0.02f * expected[c])
+                << toString(integrator) << " " << c;
         // Seen behind the sphere: the environment itself.
         EXPECT_NEAR(r.film.layer("background").rgb(0).g, 1.0f, 1e-5f) << toString(integrator);
     }
@@ -191,7 +196,8 @@ TEST(PipelineEnvironmentSlow, AZenithPatchIsADirectionalLightFromAbove) {
     light.lights = {Light::directional(Vec3f(0, 1, 0))};
     light.lights[0].intensity =
         EnvironmentMap::readExr(dir / "patch.exr", Rgb(1.0f), 0, 1u << 30).integral().g;
-    for (const GlobalTermMode mode : {GlobalTermMode::Grid, GlobalTermMode::Approx, GlobalTermMode::Exact}) {
+    for (const GlobalTermMode mode :
+         {GlobalTermMode::Grid, GlobalTermMode::Approx, GlobalTermMode::Exact}) {
         patch.globalTermMode = light.globalTermMode = mode;
         const Film a = renderScene(patch, options(dir), false).film;
         const Film b = renderScene(light, options(dir), false).film;

@@ -174,7 +174,7 @@ struct SceneAssets {
     std::shared_ptr<const EnvironmentMap> environment;
     std::unique_ptr<GlobalTermModel> environmentTerm;
     double environmentLoadSeconds = 0; ///< of times.load
-    StageTimes times; ///< load, voxelize, tables
+    StageTimes times;                  ///< load, voxelize, tables
 };
 
 /// Loads or generates the scene's groom and builds what its global-term mode needs.
@@ -201,19 +201,19 @@ struct LightReport {
 struct EnvironmentReport {
     std::string source; ///< the file, or "uniform"
     int width = 0, height = 0;
-    std::size_t mapBytes = 0;   ///< the map with its sampling distribution
+    std::size_t mapBytes = 0; ///< the map with its sampling distribution
     EnvironmentMap::NegativeFolds folds;
-    double loadSeconds = 0;     ///< reading it and building its distribution
+    double loadSeconds = 0; ///< reading it and building its distribution
     bool visible = false;
     // Dual scattering: the regions as lights.
-    std::size_t lights = 0;     ///< regions lit with
+    std::size_t lights = 0; ///< regions lit with
     EnvironmentSplit split = EnvironmentSplit::Energy;
     float widestSpreadDegrees = 0; ///< the largest region's √spread2
-    double splitSeconds = 0;    ///< the median cut and the surfaces' table
-    double prepareSeconds = 0;  ///< the regions' global terms (one after another)
-    std::size_t reusedLights = 0; ///< prepared for the frame before
-    std::size_t heldBytes = 0;  ///< their caches
-    GlobalTermStats stats;      ///< the hair's queries toward the regions
+    double splitSeconds = 0;       ///< the median cut and the surfaces' table
+    double prepareSeconds = 0;     ///< the regions' global terms (one after another)
+    std::size_t reusedLights = 0;  ///< prepared for the frame before
+    std::size_t heldBytes = 0;     ///< their caches
+    GlobalTermStats stats;         ///< the hair's queries toward the regions
 };
 
 struct SceneRender {
