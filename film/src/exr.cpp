@@ -444,13 +444,54 @@ ExrInfo readExrInfo(const std::filesystem::path& path) {
         const Imf::Header& header = file.header();
         const Imath::Box2i window = header.dataWindow();
         ExrInfo info;
-        info.width = window.max.x - window.min.x + 1;
-        info.height = window.max.y - window.min.y + 1;
+        info.width = std::int64_t(window.max.x) - window.min.x + 1;
+        info.height = std::int64_t(window.max.y) - window.min.y + 1;
+        for (auto it = header.channels().begin(); it != header.channels().end(); ++it)
+            info.channels.emplace_back(it.name());
         for (auto it = header.begin(); it != header.end(); ++it)
             if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute()))
                 info.attributes[it.name()] = s->value();
         info.complete = file.isComplete() && chunksInFile(path);
         return info;
+    } catch (const std::exception& e) {
+        throw InputError(strCat(path.string(), ": cannot read OpenEXR file: ", e.what()));
+    }
+}
+
+ExrRgbImage readExrRgb(const std::filesystem::path& path, std::uint64_t maxPixels) {
+    ExrRgbImage image;
+    std::string channels;
+    try {
+        Imf::InputFile file(path.c_str(), activeThreadCount());
+        const Imf::Header& header = file.header();
+        const Imath::Box2i window = header.dataWindow();
+        const std::int64_t width = std::int64_t(window.max.x) - window.min.x + 1;
+        const std::int64_t height = std::int64_t(window.max.y) - window.min.y + 1;
+        for (auto it = header.channels().begin(); it != header.channels().end(); ++it)
+            channels += (channels.empty() ? "" : ", ") + std::string(it.name());
+        for (const char* name : {"R", "G", "B"})
+            if (!header.channels().findChannel(name))
+                throw InputError(strCat(path.string(), ": no channel ", name,
+                                        " (an RGB or RGBA image is needed; the file has ",
+                                        channels.empty() ? std::string("none") : channels, ")"));
+        if (width < 1 || height < 1 || std::uint64_t(width) * std::uint64_t(height) > maxPixels)
+            throw InputError(strCat(path.string(), ": ", width, " x ", height,
+                                    " pixels: expected at most ", maxPixels, " pixels"));
+        image.width = int(width);
+        image.height = int(height);
+        image.rgb.assign(std::size_t(width) * std::size_t(height) * 3, 0.0f);
+        Imf::FrameBuffer frameBuffer;
+        const char* names[3] = {"R", "G", "B"};
+        for (std::size_t c = 0; c < 3; ++c)
+            frameBuffer.insert(names[c],
+                               Imf::Slice::Make(Imf::FLOAT, image.rgb.data() + c, window.min, width,
+                                                height, 3 * sizeof(float),
+                                                std::size_t(3 * width) * sizeof(float)));
+        file.setFrameBuffer(frameBuffer);
+        file.readPixels(window.min.y, window.max.y);
+        return image;
+    } catch (const InputError&) {
+        throw;
     } catch (const std::exception& e) {
         throw InputError(strCat(path.string(), ": cannot read OpenEXR file: ", e.what()));
     }

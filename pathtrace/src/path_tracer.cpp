@@ -1,3 +1,4 @@
+#include <hairvox/core/distribution.h>
 #include <hairvox/core/error.h>
 #include <hairvox/core/hash.h>
 #include <hairvox/core/interrupt.h>
@@ -110,6 +111,7 @@ struct Sample {
 
 struct Counters {
     std::uint64_t paths = 0, rays = 0, shadowRays = 0, events = 0, atCap = 0;
+    std::uint64_t environmentShadowRays = 0, escaped = 0;
     std::uint32_t deepest = 0;
     double energyAtCap = 0;
 };
@@ -133,6 +135,8 @@ public:
         for (const Light& l : scene.lights)
             if (!l.isDark())
                 lights_.push_back(l);
+        if (scene.environment && scene.environment->maxLuminance() > 0)
+            env_ = scene.environment.get();
     }
 
     /// Sample `index` of pixel (x, y): samples 2j and 2j + 1 are the j-th of
@@ -161,13 +165,36 @@ public:
         bool firstOnHair = false;
         std::optional<RayOrigin> from;
         std::uint32_t events = 0;
+        // Of the last continuation: the density it was drawn with and, at
+        // depth 1 on a fiber, each lobe's share of its weight f_p·cos/pdf
+        // (per channel: the throughput then carries roulette's factor too).
+        float continuationPdf = 0;
+        LobeValues firstShare;
+        // The continuation escaped: the map's light, weighted against light
+        // sampling's density of the same direction.
+        const auto escaped = [&] {
+            ++counters.escaped;
+            const Rgb L = env_->radiance(dir) * powerHeuristic(continuationPdf, env_->pdf(dir));
+            if (firstOnHair && events == 1) {
+                out.add(kDirectR, throughput * L * firstShare.R);
+                out.add(kDirectTT, throughput * L * firstShare.TT);
+                out.add(kDirectTRT, throughput * L * firstShare.TRT);
+            } else {
+                out.add(firstOnHair ? kMultiple : kSurface, throughput * L);
+            }
+        };
         for (;;) {
             ++counters.rays;
             const std::optional<RayHit> hit = rays_.intersect(
                 origin, dir, std::numeric_limits<float>::infinity(), from ? &*from : nullptr);
             if (!hit) {
-                if (events == 0)
-                    out.add(kBackground, scene_.background);
+                if (events == 0) {
+                    out.add(kBackground, scene_.environment && scene_.environmentVisible
+                                             ? scene_.environment->backdrop(dir)
+                                             : scene_.background);
+                } else if (env_) {
+                    escaped();
+                }
                 break;
             }
             const Vec3f xHit = origin + hit->t * dir;
@@ -207,10 +234,42 @@ public:
                         out.add(deeper, e * f.sum());
                     }
                 }
+                if (env_) {
+                    // A direction from the map, weighted against f_s sampling's density.
+                    const EnvironmentSample es =
+                        env_->sample(rng.uniformFloat(), rng.uniformFloat());
+                    const FiberAngles a = FiberAngles::fromDirections(es.omega, wo, u);
+                    if (es.pdf > 0 && !es.radiance.isBlack() && a.cosTheta_i > 0) {
+                        ++counters.shadowRays;
+                        ++counters.environmentShadowRays;
+                        if (!rays_.occluded(xHit, es.omega, std::numeric_limits<float>::infinity(),
+                                            &here)) {
+                            const LobeValues f = bcsdf.eval(a);
+                            const float w = powerHeuristic(es.pdf, bcsdf.pdf(a)) / es.pdf;
+                            const Rgb e = throughput * es.radiance * (a.cosTheta_i * w);
+                            if (events == 1) {
+                                out.add(kDirectR, e * f.R);
+                                out.add(kDirectTT, e * f.TT);
+                                out.add(kDirectTRT, e * f.TRT);
+                            } else {
+                                out.add(deeper, e * f.sum());
+                            }
+                        }
+                    }
+                }
                 const BcsdfSample s = bcsdf.sample(
                     wo, u, {rng.uniformFloat(), rng.uniformFloat(), rng.uniformFloat(), rng.uniformFloat()});
                 if (!s.valid())
                     break;
+                continuationPdf = s.pdf;
+                if (events == 1) {
+                    const float cosTheta_i = cosFromSin(std::clamp(glm::dot(s.wi, u), -1.0f, 1.0f));
+                    for (const Lobe p : kLobes)
+                        for (int c = 0; c < 3; ++c)
+                            firstShare[p][c] = s.weight[c] > 0
+                                                   ? s.f[p][c] * (cosTheta_i / s.pdf) / s.weight[c]
+                                                   : 0.0f;
+                }
                 throughput *= s.weight;
                 origin = xHit;
                 dir = s.wi;
@@ -233,11 +292,28 @@ public:
                         continue;
                     out.add(deeper, throughput * brdf * light.irradiance(path.distance) * cosTheta);
                 }
+                if (env_) {
+                    // A direction from the map, weighted against cosine sampling's density.
+                    const EnvironmentSample es =
+                        env_->sample(rng.uniformFloat(), rng.uniformFloat());
+                    const float cosTheta = glm::dot(n, es.omega);
+                    if (es.pdf > 0 && !es.radiance.isBlack() && cosTheta > 0 &&
+                        glm::dot(ng, es.omega) > 0) {
+                        ++counters.shadowRays;
+                        ++counters.environmentShadowRays;
+                        if (!rays_.occluded(xOff, es.omega, std::numeric_limits<float>::infinity()))
+                            out.add(deeper,
+                                    throughput * brdf * es.radiance *
+                                        (cosTheta *
+                                         powerHeuristic(es.pdf, cosTheta * float(InvPi)) / es.pdf));
+                    }
+                }
                 throughput *= albedo;
                 origin = xOff;
                 dir = cosineDirection(n, rng.uniformFloat(), rng.uniformFloat());
                 if (!(glm::dot(dir, ng) > 0))
                     break; // below the surface: the shading normal's lobe dips under it
+                continuationPdf = glm::dot(n, dir) * float(InvPi);
                 from.reset();
             }
             if (throughput.isBlack())
@@ -245,6 +321,14 @@ public:
             if (events >= settings_.maxDepth) {
                 ++counters.atCap;
                 counters.energyAtCap += double(throughput.average());
+                // The environment seen by this last continuation is light of
+                // this path's depth, the other half of its sample's MIS weight.
+                if (env_) {
+                    ++counters.rays;
+                    if (!rays_.intersect(origin, dir, std::numeric_limits<float>::infinity(),
+                                         from ? &*from : nullptr))
+                        escaped();
+                }
                 break;
             }
             if (events >= settings_.rouletteDepth) {
@@ -270,6 +354,7 @@ private:
     RayScene rays_;
     float slack_;
     std::vector<Light> lights_;
+    const EnvironmentMap* env_ = nullptr; ///< null: no environment light
 };
 
 /// The sums a film of this function's layers held after `spp` samples (even:
@@ -418,6 +503,8 @@ PathTraceOutput pathTrace(const PathTraceScene& scene, const PathTraceSettings& 
         st.paths += c.paths;
         st.rays += c.rays;
         st.shadowRays += c.shadowRays;
+        st.environmentShadowRays += c.environmentShadowRays;
+        st.escapedRays += c.escaped;
         st.scatteringEvents += c.events;
         st.pathsAtDepthCap += c.atCap;
         st.energyAtDepthCap += c.energyAtCap;

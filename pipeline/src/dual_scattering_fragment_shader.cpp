@@ -38,11 +38,12 @@ void put(float* out, const Rgb& c) {
 DualScatteringFragmentShader::DualScatteringFragmentShader(
     std::vector<DualScatteringShader> shaders, std::span<const std::uint8_t> fiberType,
     std::vector<Light> lights, std::vector<std::shared_ptr<const LightGlobalTerm>> lightTerms,
-    const RadianceCache* multiple)
+    ShadedEnvironment environment, const RadianceCache* multiple)
     : shaders_(std::move(shaders))
     , fiberType_(fiberType)
     , lights_(std::move(lights))
     , terms_(std::move(lightTerms))
+    , environment_(std::move(environment))
     , multiple_(multiple)
     , layout_(hairShaderLayout(lights_, multiple != nullptr))
     , stats_(lights_.size()) {}
@@ -79,6 +80,8 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
     struct Scratch {
         std::vector<GlobalTermQuery> queries;
         std::vector<GlobalTerm> terms;
+        FiberSamplePlan plan;                ///< the environment's samples along the fibers
+        std::vector<GlobalTerm> sampleTerms; ///< at them
         std::vector<ShadeBatch> batches;                 ///< per fiber type
         std::vector<std::vector<std::uint32_t>> members; ///< per fiber type: its points
     };
@@ -89,6 +92,8 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
     std::vector<GlobalTerm>& terms = scratch->terms;
     std::vector<ShadeBatch>& batches = scratch->batches;
     std::vector<std::vector<std::uint32_t>>& members = scratch->members;
+    FiberSamplePlan& plan = scratch->plan;
+    std::vector<GlobalTerm>& sampleTerms = scratch->sampleTerms;
     queries.resize(points.size());
     for (std::size_t i = 0; i < points.size(); ++i)
         queries[i] = {points[i].position,
@@ -124,27 +129,50 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
         }
     }
 
-    for (std::size_t l = 0; l < lightCount; ++l) {
-        if (terms_[l]) {
+    // The scene's lights, then the environment's (no AOVs of their own).
+    const std::size_t environmentCount = environment_.lights.size();
+    GlobalTermStats environmentStats;
+    const bool planned = environmentCount > 0 && environment_.groom && environment_.spacing > 0;
+    if (planned) {
+        const auto planStart = std::chrono::steady_clock::now();
+        plan.plan(queries, *environment_.groom, environment_.spacing);
+        sampleTerms.resize(plan.samples().size()); // every element written by evaluate
+        globalTermNanos += nanosSince(planStart);
+    }
+    for (std::size_t l = 0; l < lightCount + environmentCount; ++l) {
+        const bool ofEnvironment = l >= lightCount;
+        const std::shared_ptr<const LightGlobalTerm>& term =
+            ofEnvironment ? environment_.terms[l - lightCount] : terms_[l];
+        if (term) {
             const auto evalStart = std::chrono::steady_clock::now();
-            batchStats[l] = terms_[l]->evaluate(queries, terms);
+            if (ofEnvironment && planned) {
+                GlobalTermStats stats = term->evaluate(plan.samples(), sampleTerms);
+                plan.interpolate(sampleTerms, terms);
+                stats.queries = points.size();
+                environmentStats += stats;
+            } else {
+                (ofEnvironment ? environmentStats : batchStats[l]) +=
+                    term->evaluate(queries, terms);
+            }
             globalTermNanos += nanosSince(evalStart);
         } else {
             std::fill(terms.begin(), terms.end(), GlobalTerm::blocked());
         }
-        for (std::size_t i = 0; i < points.size(); ++i) {
-            const GlobalTerm& g = terms[i];
-            float* lightOut = out.data() + i * stride + radianceFloats + l * perLight;
-            lightOut[0] = g.V;
-            lightOut[1] = g.n;
-            if (!volumetric) {
-                put(lightOut + 2, g.T_s);
-                put(lightOut + 5, safeSqrt(g.sigma2_f));
+        if (!ofEnvironment)
+            for (std::size_t i = 0; i < points.size(); ++i) {
+                const GlobalTerm& g = terms[i];
+                float* lightOut = out.data() + i * stride + radianceFloats + l * perLight;
+                lightOut[0] = g.V;
+                lightOut[1] = g.n;
+                if (!volumetric) {
+                    put(lightOut + 2, g.T_s);
+                    put(lightOut + 5, safeSqrt(g.sigma2_f));
+                }
             }
-        }
-        if (!terms_[l])
+        if (!term)
             continue; // a skipped light contributes nothing
-        const Light& light = lights_[l];
+        const Light& light = ofEnvironment ? environment_.lights[l - lightCount] : lights_[l];
+        const float spread2 = ofEnvironment ? environment_.spread2[l - lightCount] : 0.0f;
         for (std::size_t t = 0; t < types; ++t) {
             ShadeBatch& batch = batches[t];
             if (light.kind == Light::Kind::Directional) {
@@ -162,7 +190,7 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
                     g.T_s = Rgb(0.0f); // the forward-scattered light is the cache's
                 batch.setGlobalTerm(k, g);
             }
-            shaders_[t].shade(batch);
+            shaders_[t].shade(batch, spread2);
         }
     }
     for (std::size_t t = 0; t < types; ++t) {
@@ -187,6 +215,12 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
     const std::lock_guard lock(statsMutex_);
     for (std::size_t l = 0; l < lightCount; ++l)
         stats_[l] += batchStats[l];
+    environmentStats_ += environmentStats;
+}
+
+GlobalTermStats DualScatteringFragmentShader::environmentStats() const {
+    const std::lock_guard lock(statsMutex_);
+    return environmentStats_;
 }
 
 std::vector<GlobalTermStats> DualScatteringFragmentShader::stats() const {

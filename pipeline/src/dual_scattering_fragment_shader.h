@@ -18,6 +18,7 @@
 //   averages  per light l: l.V, l.n (scalars); dual scattering also l.T_s, l.sigma_f
 //             (RGB, σ_f = √σ_f²)
 // A point is shaded with the shader of its segment's fiber type (Groom::fiberType).
+// The environment's lights add to the radiance layers like the others.
 #pragma once
 
 #include <hairvox/geometry/light.h>
@@ -38,18 +39,32 @@ namespace hairvox::detail {
 /// `multipleScattering` the volumetric integrator's.
 ShaderLayout hairShaderLayout(std::span<const Light> lights, bool multipleScattering);
 
+/// The environment's regions as lights (environment_lights.h): each shaded
+/// with its angular spread, into the radiance layers only (no per-light AOVs).
+/// With a groom and a spacing, their terms are evaluated at samples along the
+/// fibers planned once for all of them (FiberSamplePlan) and interpolated.
+struct ShadedEnvironment {
+    std::vector<Light> lights;
+    std::vector<float> spread2; ///< per light (DualScatteringShader::shade)
+    std::vector<std::shared_ptr<const LightGlobalTerm>> terms; ///< null: skipped
+    const Groom* groom = nullptr;                              ///< must outlive the shader
+    float spacing = 0; ///< world units between samples along a fiber; 0: none
+};
+
 class DualScatteringFragmentShader final : public FragmentShader {
 public:
     /// `shaders[t]` shades fiber type t; `fiberType` is the groom's
     /// (Groom::fiberType, empty for an untyped groom; it must outlive the
     /// shader). `lightTerms[l]` is the global term toward lights[l], or null
     /// for a light that is skipped (contributes nothing; its AOVs read "blocked").
+    /// `environment`: the environment's regions (ShadedEnvironment, above).
     /// `multiple` (the volumetric integrator; must outlive the shader): the
     /// multiple scattering comes from it, and the shaders give single
     /// scattering only (their back_direct and scatter are not read).
     DualScatteringFragmentShader(std::vector<DualScatteringShader> shaders,
                                  std::span<const std::uint8_t> fiberType, std::vector<Light> lights,
                                  std::vector<std::shared_ptr<const LightGlobalTerm>> lightTerms,
+                                 ShadedEnvironment environment = {},
                                  const RadianceCache* multiple = nullptr);
 
     const ShaderLayout& layout() const override { return layout_; }
@@ -60,17 +75,21 @@ public:
     double shadeThreadSeconds() const { return 1e-9 * double(shadeNanos_.load()); }
     /// Per light, summed over every batch.
     std::vector<GlobalTermStats> stats() const;
+    /// Over the environment's lights, summed over every batch.
+    GlobalTermStats environmentStats() const;
 
 private:
     std::vector<DualScatteringShader> shaders_; ///< per fiber type
     std::span<const std::uint8_t> fiberType_;
     std::vector<Light> lights_;
     std::vector<std::shared_ptr<const LightGlobalTerm>> terms_;
+    ShadedEnvironment environment_;
     const RadianceCache* multiple_;
     ShaderLayout layout_;
     mutable std::atomic<std::int64_t> globalTermNanos_{0}, shadeNanos_{0};
     mutable std::mutex statsMutex_;
     mutable std::vector<GlobalTermStats> stats_;
+    mutable GlobalTermStats environmentStats_;
 };
 
 } // namespace hairvox::detail

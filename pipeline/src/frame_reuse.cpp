@@ -31,7 +31,7 @@ std::uint64_t gridKey(std::uint64_t groom, const SplatOptions& splat) {
 
 std::uint64_t modelKey(std::uint64_t groom, std::uint64_t grid, const Scene& scene,
                        const PipelineOptions& options, const SceneGroom& sceneGroom,
-                       const SceneSurfaces& surfaces) {
+                       const SceneSurfaces& surfaces, const EnvironmentMap* environment) {
     Hasher h;
     h.value(groom).value(grid);
     for (const FiberParams& fiber : sceneGroom.palette.fibers)
@@ -53,6 +53,13 @@ std::uint64_t modelKey(std::uint64_t groom, std::uint64_t grid, const Scene& sce
         h.value(albedo);
     for (const MeshSource& mesh : scene.meshes)
         h.string(mesh.file.string());
+    h.value(environment != nullptr);
+    if (environment) {
+        environment->hashInto(h);
+        h.string(scene.environment ? scene.environment->name : std::string());
+        h.value(scene.environmentLights);
+        options.environment.hashInto(h);
+    }
     return h.digest();
 }
 

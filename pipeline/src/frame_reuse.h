@@ -47,10 +47,11 @@ std::uint64_t gridKey(std::uint64_t groom, const SplatOptions& splat);
 /// the grid (gridKey(), 0 in exact mode): the tables and crossing tables
 /// (each fiber type's optics, d_b), the model's settings (fiber scale, d_f,
 /// the surfaces' contents and colours), the global-term mode with its
-/// options, and the names the groom's and meshes' messages quote.
+/// options, the environment light (its map, colour, rotation, name and the
+/// options of its regions), and the names the groom's and meshes' messages quote.
 std::uint64_t modelKey(std::uint64_t groom, std::uint64_t grid, const Scene& scene,
                        const PipelineOptions& options, const SceneGroom& sceneGroom,
-                       const SceneSurfaces& surfaces);
+                       const SceneSurfaces& surfaces, const EnvironmentMap* environment);
 
 /// A light's prepared term under a model (modelKey()): the light, all but its name.
 std::uint64_t lightKey(std::uint64_t model, const Light& light);

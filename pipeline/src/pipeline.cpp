@@ -1,5 +1,6 @@
 #include "asset_cache.h"
 #include "dual_scattering_fragment_shader.h"
+#include "environment_lights.h"
 #include "frame_reuse.h"
 #include "surfaces.h"
 
@@ -104,6 +105,23 @@ void warnIfNoHairSeen(const Scene& scene, bool hairSeen, const Groom* groom,
 
 } // namespace
 
+void EnvironmentOptions::validate() const {
+    if (!(cacheSpacing >= 0.5f && cacheSpacing <= 4.0f))
+        throw InputError(strCat("environment cache spacing = ", cacheSpacing,
+                                " voxels: expected a number in [0.5, 4]"));
+    if (!(fiberSampleSpacing >= 0.0f && fiberSampleSpacing <= 4.0f))
+        throw InputError(strCat("environment fiber sample spacing = ", fiberSampleSpacing,
+                                " voxels: expected a number in [0, 4]"));
+    if (surfaceSubdivisions < 1 || surfaceSubdivisions > 4096)
+        throw InputError(strCat("environment surface subdivisions = ", surfaceSubdivisions,
+                                ": expected an integer in [1, 4096]"));
+}
+
+void EnvironmentOptions::hashInto(Hasher& hasher) const {
+    hasher.value(split).value(cacheSpacing).value(fiberSampleSpacing).value(surfaceSubdivisions);
+    hasher.value(spread);
+}
+
 std::uint64_t defaultMemoryLimit() {
     const long pages = sysconf(_SC_PHYS_PAGES);
     const long pageSize = sysconf(_SC_PAGE_SIZE);
@@ -165,8 +183,50 @@ MemoryEstimate estimateRenderMemory(const Scene& scene) {
             m.meshes += ec ? 0 : std::uint64_t(size) * (1 + kBytesPerTriangle / 40);
         }
     }
+    if (scene.environment && !scene.environment->file.empty()) {
+        try {
+            const ExrInfo info = readExrInfo(scene.environment->file);
+            m.environment = std::uint64_t(std::max<std::int64_t>(info.width, 0)) *
+                            std::uint64_t(std::max<std::int64_t>(info.height, 0)) *
+                            EnvironmentMap::kBytesPerPixel;
+        } catch (const InputError&) {
+            // loadEnvironment() names the problem with the file.
+        }
+    }
     return m;
 }
+
+std::shared_ptr<const EnvironmentMap> loadEnvironment(const Scene& scene, std::uint64_t maxBytes) {
+    if (!scene.environment)
+        return nullptr;
+    const EnvironmentLight& e = *scene.environment;
+    const Rgb scale = e.intensity * e.color;
+    try {
+        if (e.file.empty()) {
+            EnvironmentMap uniform = EnvironmentMap::uniform(scale);
+            return std::make_shared<const EnvironmentMap>(std::move(uniform));
+        }
+        return std::make_shared<const EnvironmentMap>(
+            EnvironmentMap::readExr(e.file, scale, e.rotation, maxBytes));
+    } catch (const InputError& error) {
+        throw InputError(
+            strCat(scene.name, ": environment light \"", e.name, "\": ", error.what()));
+    }
+}
+
+namespace {
+
+/// What the report says of the map itself.
+void describeEnvironment(const EnvironmentMap& map, const Scene& scene, EnvironmentReport& report) {
+    report.source = map.source();
+    report.width = map.width();
+    report.height = map.height();
+    report.mapBytes = map.memoryBytes();
+    report.folds = map.negativeFolds();
+    report.visible = scene.environment && scene.environment->visible;
+}
+
+} // namespace
 
 void checkVoxelSizeForGroom(const Scene& scene, const Groom& groom) {
     if (!scene.voxelSize || groom.empty())
@@ -313,6 +373,9 @@ FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, Sc
     auto start = Clock::now();
     assets->groom = loadGroom(scene);
     assets->surfaces = loadSurfaces(scene);
+    const auto environmentStart = Clock::now();
+    assets->environment = loadEnvironment(scene);
+    assets->environmentLoadSeconds = secondsSince(environmentStart);
     assets->times.load = secondsSince(start);
     throwIfInterrupted();
 
@@ -338,8 +401,8 @@ FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, Sc
         }
     }
     if (keyed)
-        out.modelKey =
-            detail::modelKey(groom, out.gridKey, scene, options, assets->groom, assets->surfaces);
+        out.modelKey = detail::modelKey(groom, out.gridKey, scene, options, assets->groom,
+                                        assets->surfaces, assets->environment.get());
     if (reuse) {
         if (reuse->assets && reuse->modelKey == out.modelKey) {
             // The same groom, surfaces, grid and model: the frame before's.
@@ -378,25 +441,34 @@ FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, Sc
     GridOptions gridOptions = options.grid;
     if (scene.fiberSampleSpacing)
         gridOptions.fiberSampleSpacing = *scene.fiberSampleSpacing;
-    switch (scene.globalTermMode) {
-    case GlobalTermMode::Exact: {
-        ExactOptions exact;
-        exact.rays = static_cast<int>(scene.exact.rays);
-        exact.radius = scene.exact.radius;
-        exact.seed = scene.exact.seed;
-        assets->globalTerm =
-            makeExactModel(assets->groom.groom, std::move(crossings), settings, exact);
-        break;
+    ExactOptions exact;
+    exact.rays = static_cast<int>(scene.exact.rays);
+    exact.radius = scene.exact.radius;
+    exact.seed = scene.exact.seed;
+    const auto makeModel = [&](CrossingTables tables, const GlobalTermSettings& s,
+                               const GridOptions& grid) -> std::unique_ptr<GlobalTermModel> {
+        switch (scene.globalTermMode) {
+        case GlobalTermMode::Exact:
+            return makeExactModel(assets->groom.groom, std::move(tables), s, exact);
+        case GlobalTermMode::Grid:
+            return makeGridModel(*assets->grid, std::move(tables), s, grid);
+        case GlobalTermMode::Approx:
+            return makeApproxModel(*assets->grid, std::move(tables), s, grid);
+        }
+        throw std::logic_error("unknown global-term mode");
+    };
+    if (assets->environment) {
+        // The environment's regions: a coarser cache, each query evaluated
+        // as it is (no surfaces' shadow, no samples along the fibers: the
+        // integrator adds both, environmentHairTerm()).
+        GlobalTermSettings open = settings;
+        open.surfaces = nullptr;
+        open.groom = nullptr;
+        GridOptions grid = gridOptions;
+        grid.cacheSpacing = options.environment.cacheSpacing;
+        assets->environmentTerm = makeModel(crossings, open, grid);
     }
-    case GlobalTermMode::Grid:
-        assets->globalTerm =
-            makeGridModel(*assets->grid, std::move(crossings), settings, gridOptions);
-        break;
-    case GlobalTermMode::Approx:
-        assets->globalTerm =
-            makeApproxModel(*assets->grid, std::move(crossings), settings, gridOptions);
-        break;
-    }
+    assets->globalTerm = makeModel(std::move(crossings), settings, gridOptions);
     assets->times.globalTerm = secondsSince(start);
     return out;
 }
@@ -416,7 +488,8 @@ namespace {
 /// unchanged (`key`).
 std::shared_ptr<const MultipleScatteringSolution>
 solveMultiple(const Scene& scene, const PipelineOptions& options, const SceneAssets& assets,
-              FrameReuse::State* reuse, std::uint64_t key, bool& reused) {
+              std::span<const Light> environmentLights, FrameReuse::State* reuse,
+              std::uint64_t key, bool& reused) {
     reused = false;
     if (reuse && reuse->multiple && reuse->multipleKey == key) {
         reused = true;
@@ -429,6 +502,7 @@ solveMultiple(const Scene& scene, const PipelineOptions& options, const SceneAss
     vs.groom = &assets.groom.groom;
     vs.fibers = assets.groom.palette.fibers;
     vs.lights = scene.lights;
+    vs.lights.insert(vs.lights.end(), environmentLights.begin(), environmentLights.end());
     vs.surfaces = assets.surfaces.scene;
     vs.surfaceAlbedo = assets.surfaces.albedo;
     VolumetricSettings settings = scene.volumetric;
@@ -481,14 +555,41 @@ SceneRender renderRasterized(const Scene& scene, const PipelineOptions& options,
     // all of theirs at once.
     // With reuse, a light prepared for the frame before under the same model
     // is taken as it is.
+    // The environment's regions are lights too (environment_lights.h), of
+    // their own model, after the scene's.
+    std::optional<detail::EnvironmentLighting> environment;
+    if (assets->environment) {
+        const auto start = Clock::now();
+        environment = detail::environmentLighting(
+            *assets->environment, scene.environment->name, scene.environmentLights,
+            options.environment.split, options.environment.surfaceSubdivisions);
+        EnvironmentReport& report = result.environment.emplace();
+        report.splitSeconds = secondsSince(start);
+        report.lights = environment->lights.size();
+        report.split = options.environment.split;
+        for (const EnvironmentRegion& region : environment->regions)
+            report.widestSpreadDegrees =
+                std::max(report.widestSpreadDegrees, degrees(std::sqrt(region.spread2)));
+        if (!options.environment.spread)
+            std::fill(environment->spread2.begin(), environment->spread2.end(), 0.0f);
+        result.times.globalTerm += report.splitSeconds;
+    }
     const std::size_t lightCount = scene.lights.size();
-    std::vector<std::shared_ptr<const LightGlobalTerm>> terms(lightCount);
-    std::vector<std::uint64_t> lightKeys(lightCount);
+    const std::size_t environmentCount = environment ? environment->lights.size() : 0;
+    std::vector<std::shared_ptr<const LightGlobalTerm>> terms(lightCount),
+        environmentTerms(environmentCount);
+    std::vector<std::uint64_t> lightKeys(lightCount), environmentKeys(environmentCount);
     if (reuse) { // the frame before's lights this frame does not have are freed first
         for (std::size_t l = 0; l < lightCount; ++l)
             lightKeys[l] = detail::lightKey(frame.modelKey, scene.lights[l]);
+        const std::uint64_t environmentModel =
+            Hasher().value(frame.modelKey).string("environment").digest();
+        for (std::size_t l = 0; l < environmentCount; ++l)
+            environmentKeys[l] = detail::lightKey(environmentModel, environment->lights[l]);
         std::erase_if(reuse->lights, [&](const auto& entry) {
-            return std::find(lightKeys.begin(), lightKeys.end(), entry.first) == lightKeys.end();
+            return std::find(lightKeys.begin(), lightKeys.end(), entry.first) == lightKeys.end() &&
+                   std::find(environmentKeys.begin(), environmentKeys.end(), entry.first) ==
+                       environmentKeys.end();
         });
     }
     result.lights.resize(lightCount);
@@ -520,6 +621,28 @@ SceneRender renderRasterized(const Scene& scene, const PipelineOptions& options,
         report.prepareSeconds = secondsSince(start);
     }
     workspace.reset(); // what no light keeps
+    if (environment) {
+        const auto start = Clock::now();
+        EnvironmentReport& report = *result.environment;
+        workspace = assets->environmentTerm->makeWorkspace();
+        for (std::size_t l = 0; l < environmentCount; ++l) {
+            if (environment->lights[l].isDark())
+                continue;
+            if (reuse)
+                if (const auto it = reuse->lights.find(environmentKeys[l]);
+                    it != reuse->lights.end()) {
+                    environmentTerms[l] = it->second;
+                    ++report.reusedLights;
+                }
+            if (!environmentTerms[l])
+                environmentTerms[l] =
+                    assets->environmentTerm->forLight(environment->lights[l], workspace.get());
+            report.heldBytes += environmentTerms[l]->memoryBytes();
+        }
+        workspace.reset();
+        report.prepareSeconds = secondsSince(start);
+        report.heldBytes += environment->surfaces.memoryBytes();
+    }
     result.globalTermPrepareSeconds = secondsSince(prepareStart);
     result.times.globalTerm += result.globalTermPrepareSeconds;
     if (reuse) { // this frame's lights, for the next (the others' caches are freed)
@@ -527,6 +650,9 @@ SceneRender renderRasterized(const Scene& scene, const PipelineOptions& options,
         for (std::size_t l = 0; l < lightCount; ++l)
             if (terms[l])
                 reuse->lights.emplace(lightKeys[l], terms[l]);
+        for (std::size_t l = 0; l < environmentCount; ++l)
+            if (environmentTerms[l])
+                reuse->lights.emplace(environmentKeys[l], environmentTerms[l]);
     }
 
     // The volumetric integrator's multiple scattering, solved once the
@@ -536,10 +662,16 @@ SceneRender renderRasterized(const Scene& scene, const PipelineOptions& options,
         const auto start = Clock::now();
         Hasher key;
         key.value(frame.modelKey);
+        // The environment's regions light the solve as they light the
+        // shader: directional lights of each region's irradiance.
+        const std::vector<Light> regions = environment ? environment->lights : std::vector<Light>{};
         for (const Light& light : scene.lights)
             key.value(detail::lightKey(frame.modelKey, light));
+        for (const Light& light : regions)
+            key.value(detail::lightKey(frame.modelKey, light));
         scene.volumetric.hashInto(key);
-        multiple = solveMultiple(scene, options, *assets, reuse, key.digest(), result.multipleReused);
+        multiple = solveMultiple(scene, options, *assets, regions, reuse, key.digest(),
+                                 result.multipleReused);
         result.volumetric = multiple->stats;
         result.times.multiple = secondsSince(start);
     }
@@ -553,11 +685,44 @@ SceneRender renderRasterized(const Scene& scene, const PipelineOptions& options,
         std::vector<const LightGlobalTerm*> lightTerms;
         for (const auto& t : terms)
             lightTerms.push_back(t.get());
+        detail::SurfaceEnvironment seen;
+        if (environment) {
+            seen.irradiance = &environment->surfaces;
+            seen.lights = environment->lights;
+            for (const auto& t : environmentTerms)
+                seen.terms.push_back(t.get());
+        }
         surfaces = detail::surfaceLayer(*assets->surfaces.scene, assets->surfaces.albedo, camera,
-                                        scene.lights, lightTerms,
+                                        scene.lights, lightTerms, environment ? &seen : nullptr,
                                         multiple ? multiple->surfaces.get() : nullptr);
     }
+    BackgroundLayer background;
+    if (assets->environment && scene.environment->visible)
+        background = detail::backgroundLayer(*assets->environment, camera);
     const double surfaceSeconds = secondsSince(surfacesStart);
+
+    // The hair's view of a region: shadowed by the surfaces along its
+    // direction, sampled along the fibers (grid and approx modes) every
+    // EnvironmentOptions::fiberSampleSpacing voxels — the surfaces' shadow
+    // too, which a directional light's keeps exact per point: a region of
+    // the sky casts a soft one, and a ray per fragment and region was a
+    // third of an environment-lit render's lookups.
+    detail::ShadedEnvironment shadedEnvironment;
+    if (environment) {
+        shadedEnvironment.lights = environment->lights;
+        shadedEnvironment.spread2 = environment->spread2;
+        for (std::size_t l = 0; l < environmentCount; ++l)
+            shadedEnvironment.terms.push_back(
+                environmentTerms[l]
+                    ? withSurfaces(std::make_unique<detail::SharedGlobalTerm>(environmentTerms[l]),
+                                   assets->surfaces.scene, environment->lights[l])
+                    : nullptr);
+        if (assets->grid) {
+            shadedEnvironment.groom = &assets->groom.groom;
+            shadedEnvironment.spacing = options.environment.fiberSampleSpacing *
+                                        static_cast<float>(assets->grid->info.voxelSize);
+        }
+    }
 
     // One shader per fiber type (the shaders refer to their bcsdf and tables).
     // The volumetric integrator reads their single scattering only: with
@@ -571,9 +736,10 @@ SceneRender renderRasterized(const Scene& scene, const PipelineOptions& options,
     for (std::size_t t = 0; t < bcsdfs.size(); ++t)
         shaders.emplace_back(bcsdfs[t], assets->tables[t], shaderParams);
     const detail::DualScatteringFragmentShader fragmentShader(
-        std::move(shaders), groom.groom.fiberType, scene.lights, std::move(terms), cache);
+        std::move(shaders), groom.groom.fiberType, scene.lights, std::move(terms),
+        std::move(shadedEnvironment), cache);
     RasterOutput image = rasterize(groom.groom, camera, fragmentShader,
-                                   rasterSettings(scene, options), surfaces);
+                                   rasterSettings(scene, options), surfaces, background);
     result.film = std::move(image.film);
     result.raster = image.stats;
     result.fiberTypes = groom.palette.size();
@@ -599,6 +765,11 @@ SceneRender renderRasterized(const Scene& scene, const PipelineOptions& options,
     const std::vector<GlobalTermStats> stats = fragmentShader.stats();
     for (std::size_t l = 0; l < stats.size(); ++l)
         result.lights[l].stats = stats[l];
+    if (result.environment) {
+        describeEnvironment(*assets->environment, scene, *result.environment);
+        result.environment->loadSeconds = assets->environmentLoadSeconds;
+        result.environment->stats = fragmentShader.environmentStats();
+    }
 
     if (assets->grid)
         result.outputAttributes["hairvox:voxel_size"] =
@@ -623,8 +794,14 @@ SceneRender renderPathTraced(const Scene& scene, const PipelineOptions& options,
     const SceneSurfaces surfaces = loadSurfaces(scene);
     for (const std::string& w : surfaces.warnings)
         result.warnings.push_back(w);
+    const auto environmentStart = Clock::now();
+    const std::shared_ptr<const EnvironmentMap> environment = loadEnvironment(scene);
+    if (environment) {
+        describeEnvironment(*environment, scene, result.environment.emplace());
+        result.environment->loadSeconds = secondsSince(environmentStart);
+    }
     result.times.load = secondsSince(start);
-    const std::string hash = pathTraceHash(scene, sceneGroom, surfaces);
+    const std::string hash = pathTraceHash(scene, sceneGroom, surfaces, environment.get());
 
     // Continue from the scene's own earlier output, if asked and it is there.
     std::optional<Film> previous;
@@ -661,6 +838,8 @@ SceneRender renderPathTraced(const Scene& scene, const PipelineOptions& options,
     pts.surfaces = surfaces.scene;
     pts.surfaceAlbedo = surfaces.albedo;
     pts.background = scene.background;
+    pts.environment = environment;
+    pts.environmentVisible = scene.environment && scene.environment->visible;
     PathTraceSettings settings = scene.pathTrace;
     settings.threads = options.threads;
     settings.progress = options.progress;
@@ -692,6 +871,7 @@ SceneRender renderPathTraced(const Scene& scene, const PipelineOptions& options,
 SceneRender renderScene(const Scene& scene, const PipelineOptions& options, bool writeFiles,
                         FrameReuse* reuse) {
     scene.validate();
+    options.environment.validate();
     const std::uint64_t limit =
         options.maxMemoryBytes > 0 ? options.maxMemoryBytes : defaultMemoryLimit();
     const MemoryEstimate memory = estimateRenderMemory(scene);
@@ -735,7 +915,7 @@ ComparedImage hairRadianceOf(const Film& film) {
 }
 
 std::string pathTraceHash(const Scene& scene, const SceneGroom& groom,
-                          const SceneSurfaces& surfaces) {
+                          const SceneSurfaces& surfaces, const EnvironmentMap* environment) {
     Hasher h;
     h.value(contentHash(groom.groom));
     h.values(std::span<const float>(groom.groom.thickness));
@@ -761,6 +941,11 @@ std::string pathTraceHash(const Scene& scene, const SceneGroom& groom,
         for (const TriangleMesh& m : surfaces.scene->meshes())
             h.value(m.contentHash());
     h.value(scene.background);
+    h.value(environment != nullptr);
+    if (environment) {
+        environment->hashInto(h);
+        h.value(scene.environment && scene.environment->visible);
+    }
     h.value(scene.pathTrace.seed)
         .value(scene.pathTrace.maxDepth)
         .value(scene.pathTrace.rouletteDepth);
@@ -850,9 +1035,31 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
     std::string written;
     for (const auto& p : r.written)
         written += (written.empty() ? "" : ", ") + p.string();
+    const auto megabytes = [](std::uint64_t bytes) {
+        return (bytes + 500'000) / 1'000'000;
+    };
+    // The environment map: what was read, and what reading it folded away.
+    const auto environmentMap = [&]() {
+        const EnvironmentReport& e = *r.environment;
+        std::string text = strCat("environment: ", e.source, ", ", e.width, "x", e.height, ", ",
+                                  megabytes(e.mapBytes), " MB with its distribution, ",
+                                  int(std::lround(1000 * e.loadSeconds)), " ms to read",
+                                  e.visible ? "; seen behind everything" : "; not seen");
+        if (e.folds.values > 0) {
+            std::snprintf(line, sizeof(line),
+                          "; %s negative values (a lossy codec's ringing, as low as %.4g) folded "
+                          "into the light within %d pixel(s) around them (%.2g%% of the energy)",
+                          thousands(e.folds.values).c_str(), double(e.folds.lowest), e.folds.radius,
+                          100 * e.folds.energy);
+            text += line;
+        }
+        more(text);
+    };
     if (r.pathTrace) {
         const PathTraceStats& pt = *r.pathTrace;
         row("load", r.times.load, "the groom");
+        if (r.environment)
+            environmentMap();
         std::snprintf(
             line, sizeof(line),
             "%u spp (%u this run%s); %s paths, %s rays + %s shadow rays: %.2f M rays/s, "
@@ -867,6 +1074,12 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
                       thousands(pt.pathsAtDepthCap).c_str(), scene.pathTrace.maxDepth,
                       pt.energyAtDepthCap);
         more(line);
+        if (r.environment)
+            more(strCat("environment: importance-sampled by luminance x sin(theta) at every "
+                        "scattering event (",
+                        thousands(pt.environmentShadowRays), " of the shadow rays), ",
+                        thousands(pt.escapedRays),
+                        " continuation rays escaped to it; both weighted by the power heuristic"));
         row("write", r.times.write, written.empty() ? "nothing" : written);
         return;
     }
@@ -876,6 +1089,8 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
             (r.surfaceTriangles > 0 ? ", " + thousands(r.surfaceTriangles) + " triangles" : ""));
     for (const std::string& note : r.groomNotes)
         more(note);
+    if (r.environment)
+        environmentMap();
     if (r.voxelSize > 0) {
         std::snprintf(line, sizeof(line), "%s active voxels of %.3g%s",
                       thousands(r.activeVoxels).c_str(), r.voxelSize,
@@ -887,9 +1102,6 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
     }
     row("tables", r.times.tables,
         strCat("dual-scattering tables (disk cache), ", r.fiberTypes, " fiber type(s)"));
-    const auto megabytes = [](std::uint64_t bytes) {
-        return (bytes + 500'000) / 1'000'000;
-    };
     std::uint64_t queries = 0, evaluated = 0, blocked = 0, empty = 0, skippedLights = 0, held = 0;
     for (const LightReport& l : r.lights) {
         held += l.heldBytes;
@@ -899,15 +1111,18 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
         empty += l.stats.emptyPaths;
         skippedLights += l.skipped ? 1 : 0;
     }
-    row("global term", r.times.globalTerm,
-        thousands(queries) + " queries" +
-            (evaluated < queries - blocked
-                 ? strCat(" (", thousands(evaluated),
-                          " evaluated, the rest interpolated along fibers)")
-                 : std::string()) +
-            "; skipped: " + thousands(skippedLights) + " light(s), " + thousands(blocked) +
-            " behind surfaces, " + thousands(empty) + " with nothing in front" +
-            (held > 0 ? strCat("; ", megabytes(held), " MB held") : std::string()));
+    if (r.lights.empty() && r.environment)
+        row("global term", r.times.globalTerm, "the environment's regions alone (below)");
+    else
+        row("global term", r.times.globalTerm,
+            thousands(queries) + " queries" +
+                (evaluated < queries - blocked
+                     ? strCat(" (", thousands(evaluated),
+                              " evaluated, the rest interpolated along fibers)")
+                     : std::string()) +
+                "; skipped: " + thousands(skippedLights) + " light(s), " + thousands(blocked) +
+                " behind surfaces, " + thousands(empty) + " with nothing in front" +
+                (held > 0 ? strCat("; ", megabytes(held), " MB held") : std::string()));
     // What each light's preparation (the grid modes' cache) took: the lights
     // are prepared one after another, so these add up to the stage's time.
     std::string prepared;
@@ -923,6 +1138,20 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
         std::snprintf(line, sizeof(line), "%.3f s preparing the lights (one after another: ",
                       r.globalTermPrepareSeconds);
         more(line + prepared + "); the rest: lookups while shading");
+    }
+    if (r.environment) {
+        const EnvironmentReport& e = *r.environment;
+        std::snprintf(
+            line, sizeof(line),
+            "environment: %zu regions by median cut of %s (%.0f ms; spread up to %.0f "
+            "deg), each a light: %.3f s preparing them%s, %s hair queries (%s "
+            "evaluated), %llu MB held",
+            e.lights, kEnvironmentSplitNames.name(e.split), 1000 * e.splitSeconds,
+            double(e.widestSpreadDegrees), e.prepareSeconds,
+            e.reusedLights > 0 ? strCat(" (", e.reusedLights, " the frame before's)").c_str() : "",
+            thousands(e.stats.queries).c_str(), thousands(e.stats.evaluated).c_str(),
+            static_cast<unsigned long long>(megabytes(e.heldBytes)));
+        more(line);
     }
     if (r.volumetric) {
         const VolumetricStats& v = *r.volumetric;

@@ -42,6 +42,7 @@ constexpr Range kDegrees{-360.0, 360.0};
 constexpr Range kAny{-1e30, 1e30};
 constexpr Range kMeshScale{-1e6, 1e6};
 constexpr std::size_t kMaxLightNameLength = 32;
+constexpr std::uint32_t kMaxEnvironmentLights = 1024;
 constexpr std::uintmax_t kMaxSceneFileBytes = 16u << 20;
 
 /// Calls `check` (an owner's validate()) and re-throws its InputError under
@@ -208,8 +209,8 @@ void parseFiber(JsonObject obj, Scene& scene) {
     obj.finish();
 }
 
-DualScatteringParams parseDualScattering(JsonObject obj) {
-    DualScatteringParams d;
+void parseDualScattering(JsonObject obj, Scene& scene) {
+    DualScatteringParams& d = scene.dualScattering;
     for (const char* key : {"d_f", "d_b"}) {
         const JsonValue v = obj[key];
         if (!v.present())
@@ -217,22 +218,27 @@ DualScatteringParams parseDualScattering(JsonObject obj) {
         (key[2] == 'f' ? d.d_f : d.d_b) = v.numberF(kAny);
         checkAt(v, [&] { d.validate(); });
     }
+    if (const JsonValue v = obj["environment_lights"]; v.present())
+        scene.environmentLights = static_cast<std::uint32_t>(v.integer(1, kMaxEnvironmentLights));
     obj.finish();
-    return d;
 }
 
 // --- lights, camera, head ----------------------------------------------------
 
-Light parseLight(JsonObject obj, std::size_t index) {
-    Light light;
-    light.name = strCat("light", index);
+/// A light's "name", or `fallback`.
+std::string parseLightName(JsonObject& obj, std::string fallback) {
     if (const JsonValue v = obj["name"]; v.present()) {
-        light.name = v.string();
-        if (!isValidLightName(light.name))
+        fallback = v.string();
+        if (!isValidLightName(fallback))
             v.failExpected(kLightNameRule);
     }
-    const Light::Kind kind =
-        obj.required("type", "\"directional\" or \"point\"").oneOf(kLightKindNames);
+    return fallback;
+}
+
+/// A directional or point light (its "type" already read).
+Light parseLight(JsonObject obj, Light::Kind kind, std::size_t index) {
+    Light light;
+    light.name = parseLightName(obj, strCat("light", index));
     if (kind == Light::Kind::Directional) {
         const JsonValue v = obj.required("direction", "a vector toward the light");
         const Vec3f d = v.vec3(kCoordinate);
@@ -250,6 +256,23 @@ Light parseLight(JsonObject obj, std::size_t index) {
         light.intensity = v.numberF(kLightIntensity);
     obj.finish();
     return light;
+}
+
+EnvironmentLight parseEnvironment(JsonObject obj, const std::filesystem::path& baseDir) {
+    EnvironmentLight env;
+    env.name = parseLightName(obj, env.name);
+    if (const JsonValue v = obj["file"]; v.present())
+        env.file = scenePath(v, baseDir);
+    if (const JsonValue v = obj["color"]; v.present())
+        env.color = v.rgb(kLightColor);
+    if (const JsonValue v = obj["intensity"]; v.present())
+        env.intensity = v.numberF(kLightIntensity);
+    if (const JsonValue v = obj["rotation"]; v.present())
+        env.rotation = v.numberF(kDegrees);
+    if (const JsonValue v = obj["visible"]; v.present())
+        env.visible = v.boolean();
+    obj.finish();
+    return env;
 }
 
 CameraParams parseCamera(JsonObject obj) {
@@ -398,6 +421,23 @@ void Scene::validate() const {
         requireInRange(field + ".intensity", l.intensity, kLightIntensity);
     }
 
+    if (environment) {
+        const EnvironmentLight& e = *environment;
+        if (!isValidLightName(e.name))
+            throw InputError(
+                strCat("environment.name \"", e.name, "\": expected ", kLightNameRule));
+        for (std::size_t j = 0; j < lights.size(); ++j)
+            if (lights[j].name == e.name)
+                throw InputError(strCat("environment.name \"", e.name, "\": used by lights[", j,
+                                        "] too; light names must be unique"));
+        requireInRange("environment.color", e.color, kLightColor);
+        requireInRange("environment.intensity", e.intensity, kLightIntensity);
+        requireInRange("environment.rotation", e.rotation, kDegrees);
+    }
+    if (environmentLights < 1 || environmentLights > kMaxEnvironmentLights)
+        throw InputError(strCat("dual_scattering.environment_lights = ", environmentLights,
+                                ": expected an integer in [1, ", kMaxEnvironmentLights, "]"));
+
     const Camera cam(camera); // checks the frame, field of view and resolution
     if (head) {
         requireInRange("head.center", head->sphere.center, kCoordinate);
@@ -489,16 +529,33 @@ Scene parseScene(const nlohmann::json& document, const std::string& sourceName,
     if (const JsonValue v = root["fiber"]; v.present())
         parseFiber(v.object(), scene);
     if (const JsonValue v = root["dual_scattering"]; v.present())
-        scene.dualScattering = parseDualScattering(v.object());
+        parseDualScattering(v.object(), scene);
 
     const JsonValue lights = root.required("lights", "an array of lights");
-    for (const JsonValue& l : lights.array(0, kMaxLights))
-        scene.lights.push_back(parseLight(l.object(), scene.lights.size()));
-    for (std::size_t i = 0; i < scene.lights.size(); ++i)
+    std::vector<std::string> names; // in the file's order, the environment's too
+    std::size_t environmentIndex = 0;
+    for (const JsonValue& l : lights.array(0, kMaxLights)) {
+        JsonObject obj = l.object();
+        const std::string type =
+            obj.required("type", "\"directional\", \"point\" or \"environment\"")
+                .oneOf({"directional", "point", "environment"});
+        if (type == "environment") {
+            if (scene.environment)
+                l.fail(strCat("a second environment light (the first is lights ", environmentIndex,
+                              "): a scene has at most one; combine the maps into one"));
+            environmentIndex = names.size();
+            scene.environment = parseEnvironment(obj, baseDir);
+            names.push_back(scene.environment->name);
+        } else {
+            scene.lights.push_back(parseLight(obj, *kLightKindNames.parse(type), names.size()));
+            names.push_back(scene.lights.back().name);
+        }
+    }
+    for (std::size_t i = 0; i < names.size(); ++i)
         for (std::size_t j = 0; j < i; ++j)
-            if (scene.lights[i].name == scene.lights[j].name)
-                lights.fail(strCat("lights ", j, " and ", i, " are both named \"",
-                                   scene.lights[i].name, "\"; light names must be unique"));
+            if (names[i] == names[j])
+                lights.fail(strCat("lights ", j, " and ", i, " are both named \"", names[i],
+                                   "\"; light names must be unique"));
 
     scene.camera = parseCamera(root.required("camera", "an object").object());
     if (const JsonValue v = root["head"]; v.present() && !v.isNull())
@@ -678,6 +735,12 @@ std::ostream& operator<<(std::ostream& os, const Scene& s) {
        << s.lights.size() << " lights";
     for (const Light& l : s.lights)
         os << " " << l;
+    if (s.environment)
+        os << ", environment(" << s.environment->name << ", "
+           << (s.environment->file.empty() ? std::string("uniform") : s.environment->file.string())
+           << ", color=" << s.environment->color << ", intensity=" << s.environment->intensity
+           << ", rotation=" << s.environment->rotation
+           << ", visible=" << (s.environment->visible ? "true" : "false") << ")";
     os << ", " << s.camera;
     if (s.head)
         os << ", head(center=" << s.head->sphere.center << ", r=" << s.head->sphere.radius

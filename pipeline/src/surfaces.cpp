@@ -222,18 +222,24 @@ void coverRow(const ViewCorners& view, int y, SurfaceLayer& layer,
 /// Each sample's Lambertian radiance lit through the hair (surfaces.h),
 /// summed over the lights in order, into `radiance`; the global term is
 /// evaluated kBatch samples at a time per light.
-void lightSamples(std::span<const ShadingSample> samples, const std::vector<Rgb>& albedo,
-                  const std::vector<Light>& lights,
+void lightSamples(const SurfaceScene& surfaces, std::span<const ShadingSample> samples,
+                  const std::vector<Rgb>& albedo, const std::vector<Light>& lights,
                   const std::vector<const LightGlobalTerm*>& terms,
-                  const SurfaceIrradiance* scattered, std::vector<Rgb>& radiance) {
+                  const SurfaceEnvironment* environment, const SurfaceIrradiance* scattered,
+                  std::vector<Rgb>& radiance) {
     struct Scratch {
         std::vector<GlobalTermQuery> queries;
         std::vector<std::size_t> which; ///< per query: its sample
         std::vector<float> cosines;     ///< per query
         std::vector<GlobalTerm> terms;  ///< per query
+        // The environment's: per query its region's light and the surfaces' shadow ray.
+        std::vector<RegionIrradiance::Value> light;
+        std::vector<Vec3f> origins, dirs;
+        std::vector<float> tMax;
+        std::vector<std::uint8_t> blocked;
     };
     ThreadScratch<Scratch> scratch;
-    auto& [queries, which, cosines, g] = *scratch;
+    auto& [queries, which, cosines, g, regionLight, origins, dirs, tMax, blocked] = *scratch;
     radiance.assign(samples.size(), Rgb(0.0f));
     for (std::size_t l = 0; l < lights.size(); ++l) {
         if (!terms[l])
@@ -275,6 +281,46 @@ void lightSamples(std::span<const ShadingSample> samples, const std::vector<Rgb>
             const ViewSample& v = samples[i].view;
             radiance[i] += float(InvPi) * albedo[v.surface] * scattered->irradiance(v.position);
         }
+    if (!environment)
+        return;
+    for (std::size_t r = 0; r < environment->terms.size(); ++r) {
+        if (!environment->terms[r])
+            continue;
+        Vec3f across, unused;
+        coordinateSystem(environment->lights[r].direction, across, unused);
+        for (std::size_t begin = 0; begin < samples.size(); begin += kBatch) {
+            const std::size_t end = std::min(samples.size(), begin + kBatch);
+            queries.clear();
+            which.clear();
+            regionLight.clear();
+            origins.clear();
+            dirs.clear();
+            for (std::size_t i = begin; i != end; ++i) {
+                const ViewSample& v = samples[i].view;
+                const RegionIrradiance::Value e = environment->irradiance->at(r, v.normal);
+                if (e.irradiance.isBlack() || !(glm::dot(v.geometricNormal, e.direction) > 0))
+                    continue;
+                const Vec3f x = v.position + surfaceOffset(v.position) * v.geometricNormal;
+                GlobalTermQuery q{x, across};
+                q.onFiber = false;
+                queries.push_back(q);
+                which.push_back(i);
+                regionLight.push_back(e);
+                origins.push_back(x);
+                dirs.push_back(e.direction);
+            }
+            g.resize(queries.size()); // every element written by evaluate
+            environment->terms[r]->evaluate(queries, g);
+            tMax.assign(queries.size(), std::numeric_limits<float>::infinity());
+            blocked.resize(queries.size()); // every element written by occluded
+            surfaces.occluded(origins, dirs, tMax, blocked);
+            for (std::size_t k = 0; k < queries.size(); ++k)
+                if (!blocked[k])
+                    radiance[which[k]] += float(InvPi) * albedo[samples[which[k]].view.surface] *
+                                          regionLight[k].irradiance *
+                                          (scattered ? Rgb(g[k].V) : Rgb(g[k].V) + g[k].T_s);
+        }
+    }
 }
 
 } // namespace
@@ -282,6 +328,7 @@ void lightSamples(std::span<const ShadingSample> samples, const std::vector<Rgb>
 SurfaceLayer surfaceLayer(const SurfaceScene& surfaces, const std::vector<Rgb>& albedo,
                           const Camera& camera, const std::vector<Light>& lights,
                           const std::vector<const LightGlobalTerm*>& terms,
+                          const SurfaceEnvironment* environment,
                           const SurfaceIrradiance* scattered) {
     const int width = camera.width(), height = camera.height();
     const std::size_t pixels = std::size_t(width) * std::size_t(height);
@@ -337,7 +384,7 @@ SurfaceLayer surfaceLayer(const SurfaceScene& surfaces, const std::vector<Rgb>& 
                                       width, Rgb(0.0f));
             coverRow(view, y, layer, samples);
         }
-        lightSamples(samples, albedo, lights, terms, scattered, radiance);
+        lightSamples(surfaces, samples, albedo, lights, terms, environment, scattered, radiance);
         for (std::size_t i = 0; i < samples.size(); ++i)
             layer.radiance[samples[i].pixel] += samples[i].weight * radiance[i];
     });

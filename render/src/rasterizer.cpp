@@ -129,6 +129,7 @@ struct RenderContext {
     const ShaderLayout& layout;
     const RasterSettings& settings;
     const SurfaceLayer& surfaces;
+    const BackgroundLayer& background;
     std::size_t stride;         ///< floats per shaded point
     std::size_t radianceFloats; ///< of those, the radiance layers'
     LargeVector<Vec3f> tangents;
@@ -152,13 +153,14 @@ struct RenderContext {
     }
 
     RenderContext(const Groom& g, const Camera& c, const FragmentShader& sh,
-                  const RasterSettings& st, const SurfaceLayer& su)
+                  const RasterSettings& st, const SurfaceLayer& su, const BackgroundLayer& bg)
         : groom(g)
         , camera(c)
         , shader(sh)
         , layout(sh.layout())
         , settings(st)
         , surfaces(su)
+        , background(bg)
         , stride(layout.stride())
         , radianceFloats(layout.radianceFloats()) {}
 
@@ -736,7 +738,9 @@ private:
             alpha.set(i, 0, 1.0f - st.T);
             hairAlpha.set(i, 0, st.hairWeight);
             depth.set(i, 0, st.T < 1.0f ? st.depthSum / (1.0f - st.T) : 0.0f);
-            const Rgb b = st.T * ctx_.settings.background;
+            const Rgb b =
+                st.T * (ctx_.background.empty() ? ctx_.settings.background
+                                                : ctx_.background.radiance[imageIndex(p)]);
             for (int c = 0; c < 3; ++c) {
                 const auto k = std::size_t(c);
                 surface.set(i, k, st.surface[c]);
@@ -1083,7 +1087,8 @@ std::vector<RasterLayer> rasterLayers(const ShaderLayout& layout) {
 }
 
 RasterOutput rasterize(const Groom& groom, const Camera& camera, const FragmentShader& shader,
-                       const RasterSettings& settings, const SurfaceLayer& surfaces) {
+                       const RasterSettings& settings, const SurfaceLayer& surfaces,
+                       const BackgroundLayer& background) {
     const Clock::time_point start = Clock::now();
     settings.fiberScale.validate();
     if (!(settings.opaqueTransmittance >= 0.0f && settings.opaqueTransmittance < 1.0f))
@@ -1107,9 +1112,13 @@ RasterOutput rasterize(const Groom& groom, const Camera& camera, const FragmentS
          surfaces.radiance.size() != pixels))
         throw InputError(strCat("surface layer of ", surfaces.coverage.size(), " pixels for a ",
                                 camera.width(), " x ", camera.height(), " camera"));
+    if (!background.empty() && background.radiance.size() != pixels)
+        throw InputError(strCat("background layer of ", background.radiance.size(),
+                                " pixels for a ", camera.width(), " x ", camera.height(),
+                                " camera"));
     const ThreadLimit threadLimit(settings.threads);
 
-    RenderContext ctx(groom, camera, shader, settings, surfaces);
+    RenderContext ctx(groom, camera, shader, settings, surfaces, background);
     RasterOutput out;
     out.film = Film(camera.width(), camera.height());
     Film& film = out.film;

@@ -41,9 +41,22 @@ DualScatteringShader::DualScatteringShader(const MarschnerBcsdf& bcsdf,
 
 namespace {
 
-detail::ShadeKernelParams kernelParams(const DualScatteringShader& shader) {
-    return {detail::marschnerView(shader.bcsdf()), detail::tablesView(shader.tables()),
-            shader.params().d_b};
+/// The kernel's view of the shader, for a light of angular variance
+/// `spread2` per axis (rad²): θ_i spread by it spreads θ_h = (θ_i + θ_o)/2 by
+/// a quarter of it, a variance every longitudinal lobe adds to its own.
+detail::ShadeKernelParams kernelParams(const DualScatteringShader& shader, float spread2 = 0) {
+    detail::ShadeKernelParams p{detail::marschnerView(shader.bcsdf()),
+                                detail::tablesView(shader.tables()), shader.params().d_b};
+    if (spread2 > 0) {
+        p.lightVariance = 0.25f * spread2;
+        for (std::size_t lobe = 0; lobe < 3; ++lobe) {
+            const LongitudinalLobe M(p.fs.alpha[lobe], p.fs.variance[lobe] + p.lightVariance);
+            p.fs.variance[lobe] += p.lightVariance;
+            p.fs.scale[lobe] = M.scale();
+            p.fs.invTwoVariance[lobe] = M.invTwoVariance();
+        }
+    }
+    return p;
 }
 
 /// The kernel's global-term rows of one point (detail::kV ... kSigma2B).
@@ -129,14 +142,15 @@ ShadeResult ShadeBatch::radiance(std::size_t i) const {
     return shadeResultOf(v);
 }
 
-void DualScatteringShader::shade(ShadeBatch& batch) const {
+void DualScatteringShader::shade(ShadeBatch& batch, float spread2) const {
     if (batch.count_ == 0)
         return;
     const std::size_t n = batch.count_, capacity = batch.capacity_;
     const float* in = batch.inputs_.data();
-    detail::shadeDirections(
-        kernelParams(*this), {n, capacity, in}, {n, capacity, in + kGlobalTermRow * capacity},
-        {n, capacity, in + kIrradianceRow * capacity}, {n, capacity, batch.radiance_.data()});
+    detail::shadeDirections(kernelParams(*this, spread2), {n, capacity, in},
+                            {n, capacity, in + kGlobalTermRow * capacity},
+                            {n, capacity, in + kIrradianceRow * capacity},
+                            {n, capacity, batch.radiance_.data()});
 }
 
 ShadeResult DualScatteringShader::shade(const Vec3f& wi, const Vec3f& wo, const Vec3f& u,

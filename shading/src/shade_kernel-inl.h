@@ -350,13 +350,14 @@ ShadeV shade(const ShadeKernelParams& p, const Angles& a, const GlobalTermV& g, 
         r.directR = zeroUnless(direct, f.R * w);
         r.directTT = zeroUnless(direct, f.TT * w);
         r.directTRT = zeroUnless(direct, f.TRT * w);
-        r.backDirect = zeroUnless(direct, fBack(a, b, none) * hn::Mul(constant(p.d_b), w));
+        r.backDirect = zeroUnless(direct, fBack(a, b, splat(constant(p.lightVariance))) *
+                                              hn::Mul(constant(p.d_b), w));
     }
     if (!hn::AllFalse(D(), scatter) || terms) {
         const Rgb3 sigma2_f{hn::Max(g.sigma2_f.r, zero), hn::Max(g.sigma2_f.g, zero),
                             hn::Max(g.sigma2_f.b, zero)};
         const Rgb3 fs = fsScatter(p, a, sigma2_f);
-        const Rgb3 back = fBack(a, b, sigma2_f);
+        const Rgb3 back = fBack(a, b, sigma2_f + splat(constant(p.lightVariance)));
         r.scatter = zeroUnless(scatter, g.T_s * (fs + back * constant(kPi * p.d_b)) * a.cosTheta_i);
         r.fsScatterTerm = fs;
         r.fBackTerm = back;

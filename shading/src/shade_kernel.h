@@ -61,6 +61,9 @@ struct ShadeKernelParams {
     MarschnerView fs;
     DualScatteringTablesView ds;
     float d_b = 1;
+    /// The incident light's own longitudinal variance in θ_h (rad²), added to
+    /// f_back's (fs's lobe variances carry it already): 0 for a directional light.
+    float lightVariance = 0;
 };
 
 /// Rows of a batch of directions (unit vectors): ω_i, ω_o, u.

@@ -220,7 +220,7 @@ TEST(Scene, WrongTypesNameTheirPathAndTheExpectedType) {
     j = validScene();
     j["lights"][0]["type"] = "spot";
     EXPECT_EQ(errorOf(j), "scene.json: /lights/0/type: expected one of \"directional\", "
-                          "\"point\", got \"spot\"");
+                          "\"point\", \"environment\", got \"spot\"");
     j = validScene();
     j["groom"]["procedural"]["strands"] = 1.5;
     EXPECT_EQ(errorOf(j), "scene.json: /groom/procedural/strands: expected an integer in "

@@ -250,6 +250,17 @@ def malformed():
         "no_such_groom.hair")
     bad("malformed_groom_file.json", scene_with(groom={"file": "nan_coordinate.hair"}),
         "non-finite coordinate")
+    bad("environment_missing_file.json",
+        scene_with(lights=[{"type": "environment", "file": "no_such_map.exr"}]),
+        "environment light \"environment\": no_such_map.exr: cannot read OpenEXR file")
+    bad("environment_not_an_exr.json",
+        scene_with(lights=[{"type": "environment", "file": "empty.obj"}]),
+        "empty.obj: cannot read OpenEXR file")
+    bad("environment_two.json",
+        scene_with(lights=[{"type": "environment"}, {"type": "environment", "file": "a.exr"}]),
+        "a scene has at most one")
+    bad("environment_rotation.json",
+        scene_with(lights=[{"type": "environment", "rotation": 1e9}]), "/lights/0/rotation")
     bad("binary_garbage.json", bytes((i * 151 + 7) % 256 for i in range(1024)), "invalid JSON")
     bad("utf16.json", scene_with().encode("utf-16"), "invalid JSON")
 

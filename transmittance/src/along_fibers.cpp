@@ -28,7 +28,7 @@ class AlongFibers final : public LightGlobalTerm {
 public:
     AlongFibers(std::unique_ptr<LightGlobalTerm> inner, const Groom& groom, float spacing)
         : inner_(std::move(inner))
-        , points_(groom.points)
+        , groom_(groom)
         , spacing_(spacing) {}
 
     std::size_t memoryBytes() const override { return inner_->memoryBytes(); }
@@ -36,116 +36,118 @@ public:
 
     GlobalTermStats evaluate(std::span<const GlobalTermQuery> queries,
                              std::span<GlobalTerm> out) const override {
-        // Per query: the sample at or below it (an index into `samples`) and
-        // the fraction toward the next one, which is the sample after it; a
-        // query on a sample (f = 0: a strand vertex, as the vertex rate and
-        // the tail shade) needs that sample alone.
-        struct Where {
-            std::uint32_t sample;
-            float f;
-        };
         struct Scratch {
-            std::vector<GlobalTermQuery> samples;
-            std::vector<Where> where; // every element written before it is read
-            std::vector<int> needed;  // sample numbers along the current segment
+            FiberSamplePlan plan;
             std::vector<GlobalTerm> values;
         };
         ThreadScratch<Scratch> scratch;
-        auto& [samples, where, needed, values] = *scratch;
-        samples.clear();
-        where.resize(queries.size());
-        std::size_t i = 0;
-        while (i < queries.size()) {
-            const GlobalTermQuery& q = queries[i];
-            if (q.segment == kUnknownSegment || !q.onFiber ||
-                std::size_t(q.segment) + 1 >= points_.size()) {
-                where[i++] = {static_cast<std::uint32_t>(samples.size()), 0.0f};
-                samples.push_back(q);
-                continue;
-            }
-            // The run of queries on this segment, each at t = x/m, x ∈ [k, k + 1].
-            const Vec3f p0 = points_[q.segment], d = points_[q.segment + 1] - p0;
-            const float length2 = glm::dot(d, d);
-            // (At least 1 — also for a NaN length — and capped, so that an
-            // absurd length/spacing ratio cannot overflow the sample index.)
-            const float ratio = std::sqrt(length2) / spacing_;
-            const int m =
-                ratio > 1.0f ? static_cast<int>(std::min(std::ceil(ratio), float(1 << 30))) : 1;
-            const float scale = length2 > 0 ? float(m) / length2 : 0.0f;
-            std::size_t end = i;
-            int kMin = m, kMax = 0; // the first and last sample needed
-            for (;
-                 end < queries.size() && queries[end].segment == q.segment && queries[end].onFiber;
-                 ++end) {
-                const float along = glm::dot(queries[end].position - p0, d) * scale;
-                const float x = along > 0 ? std::min(along, float(m)) : 0.0f; // NaN → 0
-                const int k = static_cast<int>(x);
-                where[end] = {static_cast<std::uint32_t>(k), x - float(k)};
-                kMin = std::min(kMin, k);
-                kMax = std::max(kMax, where[end].f > 0 ? k + 1 : k);
-            }
-            // The samples the run needs: all of kMin ... kMax when the
-            // queries lie dense along the segment (the common case: several
-            // fragments per sample), else just each query's k and, between
-            // samples, k + 1 (a long segment seen from afar). Either way a
-            // query's value depends only on its own position, not on the
-            // batch.
-            needed.clear();
-            const bool dense = std::size_t(kMax - kMin + 1) <= 2 * (end - i);
-            if (dense) {
-                for (int k = kMin; k <= kMax; ++k)
-                    needed.push_back(k);
-            } else {
-                for (std::size_t j = i; j < end; ++j) {
-                    needed.push_back(static_cast<int>(where[j].sample));
-                    if (where[j].f > 0)
-                        needed.push_back(static_cast<int>(where[j].sample) + 1);
-                }
-                std::sort(needed.begin(), needed.end());
-                needed.erase(std::unique(needed.begin(), needed.end()), needed.end());
-            }
-            const auto base = static_cast<std::uint32_t>(samples.size());
-            const Vec3f tangent = normalizeOr(d, q.tangent);
-            for (int k : needed) {
-                // Field by field into the array: a whole query built on the
-                // stack and copied was read back in 16-byte pieces over its
-                // 1-byte fields just stored, a store-forwarding stall (its two
-                // instructions took a fifth of this function's samples on the
-                // head; the function's samples fell 7%).
-                GlobalTermQuery& sample = samples.emplace_back();
-                sample.position = p0 + (float(k) / float(m)) * d;
-                sample.tangent = tangent;
-                sample.strand = q.strand;
-                sample.onFiber = true;
-                sample.fiberType = q.fiberType;
-                sample.segment = kUnknownSegment;
-            }
-            for (std::size_t j = i; j < end; ++j) {
-                const int k = static_cast<int>(where[j].sample);
-                const auto offset =
-                    dense ? k - kMin
-                          : std::lower_bound(needed.begin(), needed.end(), k) - needed.begin();
-                where[j].sample = base + static_cast<std::uint32_t>(offset);
-            }
-            i = end;
-        }
-        values.resize(samples.size()); // every element written by the inner term
-        GlobalTermStats stats = inner_->evaluate(samples, values);
-        for (std::size_t j = 0; j < queries.size(); ++j) {
-            const Where w = where[j];
-            out[j] = w.f > 0 ? lerp(w.f, values[w.sample], values[w.sample + 1]) : values[w.sample];
-        }
+        auto& [plan, values] = *scratch;
+        plan.plan(queries, groom_, spacing_);
+        values.resize(plan.samples().size()); // every element written by the inner term
+        GlobalTermStats stats = inner_->evaluate(plan.samples(), values);
+        plan.interpolate(values, out);
         stats.queries = queries.size();
         return stats;
     }
 
 private:
     std::unique_ptr<LightGlobalTerm> inner_;
-    const std::vector<Vec3f>& points_;
+    const Groom& groom_;
     float spacing_;
 };
 
 } // namespace
+
+void FiberSamplePlan::plan(std::span<const GlobalTermQuery> queries, const Groom& groom,
+                           float spacing) {
+    const std::vector<Vec3f>& points = groom.points;
+    // Per query: the sample at or below it and the fraction toward the next
+    // one, which is the sample after it; a query on a sample (f = 0: a strand
+    // vertex, as the vertex rate and the tail shade) needs that sample alone.
+    samples_.clear();
+    where_.resize(queries.size());
+    std::size_t i = 0;
+    while (i < queries.size()) {
+        const GlobalTermQuery& q = queries[i];
+        if (q.segment == kUnknownSegment || !q.onFiber ||
+            std::size_t(q.segment) + 1 >= points.size()) {
+            where_[i++] = {static_cast<std::uint32_t>(samples_.size()), 0.0f};
+            samples_.push_back(q);
+            continue;
+        }
+        // The run of queries on this segment, each at t = x/m, x ∈ [k, k + 1].
+        const Vec3f p0 = points[q.segment], d = points[q.segment + 1] - p0;
+        const float length2 = glm::dot(d, d);
+        // (At least 1 — also for a NaN length — and capped, so that an
+        // absurd length/spacing ratio cannot overflow the sample index.)
+        const float ratio = std::sqrt(length2) / spacing;
+        const int m =
+            ratio > 1.0f ? static_cast<int>(std::min(std::ceil(ratio), float(1 << 30))) : 1;
+        const float scale = length2 > 0 ? float(m) / length2 : 0.0f;
+        std::size_t end = i;
+        int kMin = m, kMax = 0; // the first and last sample needed
+        for (; end < queries.size() && queries[end].segment == q.segment && queries[end].onFiber;
+             ++end) {
+            const float along = glm::dot(queries[end].position - p0, d) * scale;
+            const float x = along > 0 ? std::min(along, float(m)) : 0.0f; // NaN → 0
+            const int k = static_cast<int>(x);
+            where_[end] = {static_cast<std::uint32_t>(k), x - float(k)};
+            kMin = std::min(kMin, k);
+            kMax = std::max(kMax, where_[end].f > 0 ? k + 1 : k);
+        }
+        // The samples the run needs: all of kMin ... kMax when the queries
+        // lie dense along the segment (the common case: several fragments per
+        // sample), else just each query's k and, between samples, k + 1 (a
+        // long segment seen from afar). Either way a query's value depends
+        // only on its own position, not on the batch.
+        needed_.clear();
+        const bool dense = std::size_t(kMax - kMin + 1) <= 2 * (end - i);
+        if (dense) {
+            for (int k = kMin; k <= kMax; ++k)
+                needed_.push_back(k);
+        } else {
+            for (std::size_t j = i; j < end; ++j) {
+                needed_.push_back(static_cast<int>(where_[j].sample));
+                if (where_[j].f > 0)
+                    needed_.push_back(static_cast<int>(where_[j].sample) + 1);
+            }
+            std::sort(needed_.begin(), needed_.end());
+            needed_.erase(std::unique(needed_.begin(), needed_.end()), needed_.end());
+        }
+        const auto base = static_cast<std::uint32_t>(samples_.size());
+        const Vec3f tangent = normalizeOr(d, q.tangent);
+        for (int k : needed_) {
+            // Field by field into the array: a whole query built on the stack
+            // and copied was read back in 16-byte pieces over its 1-byte
+            // fields just stored, a store-forwarding stall (its two
+            // instructions took a fifth of this function's samples on the
+            // head; the function's samples fell 7%).
+            GlobalTermQuery& sample = samples_.emplace_back();
+            sample.position = p0 + (float(k) / float(m)) * d;
+            sample.tangent = tangent;
+            sample.strand = q.strand;
+            sample.onFiber = true;
+            sample.fiberType = q.fiberType;
+            sample.segment = kUnknownSegment;
+        }
+        for (std::size_t j = i; j < end; ++j) {
+            const int k = static_cast<int>(where_[j].sample);
+            const auto offset =
+                dense ? k - kMin
+                      : std::lower_bound(needed_.begin(), needed_.end(), k) - needed_.begin();
+            where_[j].sample = base + static_cast<std::uint32_t>(offset);
+        }
+        i = end;
+    }
+}
+
+void FiberSamplePlan::interpolate(std::span<const GlobalTerm> values,
+                                  std::span<GlobalTerm> out) const {
+    for (std::size_t j = 0; j < where_.size(); ++j) {
+        const Where w = where_[j];
+        out[j] = w.f > 0 ? lerp(w.f, values[w.sample], values[w.sample + 1]) : values[w.sample];
+    }
+}
 
 std::unique_ptr<LightGlobalTerm> alongFibers(std::unique_ptr<LightGlobalTerm> inner,
                                              const Groom& groom, float spacing) {

@@ -35,6 +35,8 @@ struct RgbT {
     constexpr RgbT& operator/=(T s) { r /= s; g /= s; b /= s; return *this; }
 
     constexpr T average() const { return (r + g + b) / T(3); }
+    /// Relative luminance Y of linear Rec. 709 / sRGB primaries (ITU-R BT.709).
+    constexpr T luminance() const { return T(0.2126) * r + T(0.7152) * g + T(0.0722) * b; }
     constexpr T maxComponent() const { return std::max({r, g, b}); }
     constexpr T minComponent() const { return std::min({r, g, b}); }
     bool isFinite() const { return std::isfinite(r) && std::isfinite(g) && std::isfinite(b); }

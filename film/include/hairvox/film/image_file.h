@@ -85,17 +85,33 @@ struct ExrImage {
 /// Throws InputError naming the file if it cannot be read.
 ExrImage readExr(const std::filesystem::path& path);
 
-/// What an EXR file's header says, its pixels not read: the string
-/// attributes, the size, and whether every chunk of the data window is in
-/// the file (OpenEXR's isComplete(): false for a file cut short).
+/// What an EXR file's header says, its pixels not read: the size of the data
+/// window, the channels, the string attributes, and whether every chunk of
+/// the data window is in the file (OpenEXR's isComplete(): false for a file
+/// cut short).
 struct ExrInfo {
-    int width = 0, height = 0;
+    std::int64_t width = 0, height = 0;         ///< of the data window
+    std::vector<std::string> channels;          ///< their names, in the file's order
     std::map<std::string, std::string> attributes;
     bool complete = false;
 };
 
 /// Throws InputError naming the file if it is not a readable EXR.
 ExrInfo readExrInfo(const std::filesystem::path& path);
+
+/// An EXR's colour: its R, G and B channels as floats.
+struct ExrRgbImage {
+    int width = 0, height = 0;
+    std::vector<float> rgb; ///< row-major, 3 floats a pixel (R, G, B)
+};
+
+/// Reads the R, G and B channels of an EXR file (half, float or uint; any
+/// compression OpenEXR reads, DWA included; scanline or tiled; the first part
+/// of a multi-part file); an alpha or any other channel is ignored. Checks its
+/// header first: InputError naming the file if it cannot be read, lacks one
+/// of R, G, B (the message lists its channels) or holds more than maxPixels
+/// pixels (nothing is allocated for it then).
+ExrRgbImage readExrRgb(const std::filesystem::path& path, std::uint64_t maxPixels);
 
 /// The film an EXR image holds: channels R, G, B as the beauty layer "",
 /// X.R, X.G, X.B as the RGB layer X, any other channel as a scalar layer of its

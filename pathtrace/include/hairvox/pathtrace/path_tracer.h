@@ -19,6 +19,21 @@
 // continuation (throughput × albedo). The background is what camera rays see
 // where they meet nothing; it lights nothing (as in the rasterizer).
 //
+// The environment light (geometry/environment_map.h), when the scene has one:
+// at every scattering event one direction is drawn from the map's importance
+// distribution (luminance × sin θ) and shadow-tested like a light, and every
+// continuation ray that escapes sees the map — each weighted by the power
+// heuristic against the other strategy's density (the fiber's f_s sampling,
+// MarschnerBcsdf::pdf, or the surface's cos θ/π), so that a sun a few pixels
+// wide is found by light sampling and a narrow R lobe by the fiber's. Camera
+// rays that meet nothing see its backdrop when it is visible, the background
+// colour otherwise. Escaped light is filed like a light's: by lobe at depth 1
+// on a fiber (the direct_* layers), in `multiple` deeper, in `surface` on a
+// path that began on a surface. A path stopped by `maxDepth` still traces its
+// last continuation to the environment: that light is of the path's own
+// depth (the other strategy of its last event), so that maxDepth = 1 is
+// single scattering in full.
+//
 // Russian roulette from depth `rouletteDepth` on, with survival probability
 // min(1, max channel of the throughput): unbiased, and light hair (albedo ~0.6
 // per scattering) still reaches dozens of bounces when they matter. `maxDepth`
@@ -63,6 +78,7 @@
 #include <hairvox/core/rgb.h>
 #include <hairvox/film/film.h>
 #include <hairvox/geometry/camera.h>
+#include <hairvox/geometry/environment_map.h>
 #include <hairvox/geometry/light.h>
 #include <hairvox/geometry/surface_scene.h>
 #include <hairvox/shading/fiber_params.h>
@@ -91,6 +107,11 @@ struct PathTraceScene {
     std::shared_ptr<const SurfaceScene> surfaces;
     std::vector<Rgb> surfaceAlbedo;
     Rgb background{0.0f};
+    /// The environment light (null: none). Lights every path (see above).
+    std::shared_ptr<const EnvironmentMap> environment;
+    /// Camera rays that meet nothing see the environment's backdrop instead
+    /// of `background`.
+    bool environmentVisible = false;
 };
 
 struct PathTraceSettings {
@@ -116,6 +137,10 @@ struct PathTraceStats {
     std::uint64_t paths = 0;        ///< this run's
     std::uint64_t rays = 0;         ///< camera and continuation rays (closest hit)
     std::uint64_t shadowRays = 0;   ///< next-event rays (any hit)
+    /// Of those, toward directions drawn from the environment map.
+    std::uint64_t environmentShadowRays = 0;
+    /// Continuation rays that escaped to the environment (after a scattering event).
+    std::uint64_t escapedRays = 0;
     std::uint64_t scatteringEvents = 0; ///< at fibers and surfaces
     std::uint32_t deepestPath = 0;  ///< the most scattering events a path had
     std::uint64_t pathsAtDepthCap = 0;

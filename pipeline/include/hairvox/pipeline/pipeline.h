@@ -12,7 +12,9 @@
 #pragma once
 
 #include <hairvox/core/disk_cache.h>
+#include <hairvox/core/hash.h>
 #include <hairvox/film/image_compare.h>
+#include <hairvox/geometry/environment_map.h>
 #include <hairvox/pathtrace/path_tracer.h>
 #include <hairvox/pipeline/scene.h>
 #include <hairvox/render/rasterizer.h>
@@ -34,11 +36,38 @@
 
 namespace hairvox {
 
+/// How the dual-scattering integrator lights with an environment
+/// (docs/environment.md, where each default is measured against the path
+/// tracer). The number of regions is the scene's (Scene::environmentLights).
+struct EnvironmentOptions {
+    /// What the median cut weighs: energy (the default), or solid angle (the
+    /// baseline of uniform directions).
+    EnvironmentSplit split = EnvironmentSplit::Energy;
+    /// The regions' lights in the grid modes: voxels between their caches'
+    /// shadow lines (GridOptions::cacheSpacing) and between their samples
+    /// along the fibers (GridOptions::fiberSampleSpacing; the surfaces'
+    /// shadow on the hair is sampled there too). An area of the sky casts
+    /// softer shadows than a directional light. [0.5, 4] and [0, 4].
+    float cacheSpacing = 3.0f;
+    float fiberSampleSpacing = 2.0f;
+    /// Sub-regions a region is cut into for what surfaces see of it
+    /// (environment_lights.h RegionIrradiance).
+    std::size_t surfaceSubdivisions = 16; ///< [1, 4096]
+    /// Widen the fiber's lobes by each region's angular spread; false: every
+    /// region a directional light.
+    bool spread = true;
+
+    /// InputError naming the option and its range.
+    void validate() const;
+    void hashInto(Hasher& hasher) const;
+};
+
 struct PipelineOptions {
     int threads = 0;       ///< 0: all cores
     bool progress = false; ///< progress bars on stderr (the caller checks for a terminal)
     std::filesystem::path tableCacheDir; ///< empty: defaultTableCacheDir()
     GridOptions grid; ///< settings of the grid and approx modes (measured defaults)
+    EnvironmentOptions environment; ///< of an environment light, dual scattering
     /// Path tracing: add samples to the scene's own EXR output when it exists
     /// (InputError if it was rendered from another scene or seed).
     bool continuePathTrace = false;
@@ -77,11 +106,14 @@ struct MemoryEstimate {
     std::uint64_t film = 0;  ///< film layers + per-pixel integrator buffers + output encoding
     std::uint64_t groom = 0; ///< points, per-point render buffers, acceleration structure
     std::uint64_t meshes = 0; ///< the OBJ text while read, triangles, normals, Embree's BVH
+    /// The environment map (EnvironmentMap::kBytesPerPixel a pixel, from its
+    /// file's header; 0 when the header cannot be read: loading says why).
+    std::uint64_t environment = 0;
     /// Libraries, tables, the fiber grid and per-light caches of a typical
     /// groom (the default scene peaks at ~1.1 GiB at 2000², ~430 MiB at 500²).
     std::uint64_t fixed = 320ull << 20;
     int filmChannels = 0; ///< float channels per pixel in the film
-    std::uint64_t total() const { return film + groom + meshes + fixed; }
+    std::uint64_t total() const { return film + groom + meshes + environment + fixed; }
 };
 MemoryEstimate estimateRenderMemory(const Scene& scene);
 
@@ -121,6 +153,18 @@ struct SceneSurfaces {
 /// for a mesh that cannot be used.
 SceneSurfaces loadSurfaces(const Scene& scene);
 
+/// What an environment map may take at most: 1 GiB (26.8M pixels, e.g. 7300 x
+/// 3650, at EnvironmentMap::kBytesPerPixel).
+inline constexpr std::uint64_t kEnvironmentBudgetBytes = 1ull << 30;
+
+/// The scene's environment map, read from its file (with its colour,
+/// intensity and rotation) or uniform; null when the scene has none.
+/// InputError naming the scene, the light and the file for a map that cannot
+/// be used (geometry/environment_map.h: unreadable, not RGB, not 2:1,
+/// negative or non-finite pixels, over `maxBytes`).
+std::shared_ptr<const EnvironmentMap>
+loadEnvironment(const Scene& scene, std::uint64_t maxBytes = kEnvironmentBudgetBytes);
+
 /// The scene's groom, generated or read from its file, with its per-point
 /// attributes resolved (groom_attributes.h): groom.thickness holds diameters
 /// in scene units, groom.fiberType indexes `palette`.
@@ -142,7 +186,14 @@ struct SceneAssets {
     std::shared_ptr<const FiberGrid> grid;
     std::vector<DualScatteringTables> tables;    ///< per fiber type (groom.palette)
     std::unique_ptr<GlobalTermModel> globalTerm; ///< refers to `grid`: keep the assets together
-    StageTimes times;                            ///< load, voxelize, tables
+    /// The environment light's map (null: none) and the model of its
+    /// regions' global terms: the scene's mode with EnvironmentOptions'
+    /// spacings and without the surfaces' shadow (their rays are cast
+    /// along what each point sees of a region, environment_lights.h).
+    std::shared_ptr<const EnvironmentMap> environment;
+    std::unique_ptr<GlobalTermModel> environmentTerm;
+    double environmentLoadSeconds = 0; ///< of times.load
+    StageTimes times;                  ///< load, voxelize, tables
 };
 
 /// Loads or generates the scene's groom and builds what its global-term mode needs.
@@ -165,6 +216,25 @@ struct LightReport {
     GlobalTermStats stats;
 };
 
+/// What the environment light cost and how it was sampled.
+struct EnvironmentReport {
+    std::string source; ///< the file, or "uniform"
+    int width = 0, height = 0;
+    std::size_t mapBytes = 0; ///< the map with its sampling distribution
+    EnvironmentMap::NegativeFolds folds;
+    double loadSeconds = 0; ///< reading it and building its distribution
+    bool visible = false;
+    // Dual scattering: the regions as lights.
+    std::size_t lights = 0; ///< regions lit with
+    EnvironmentSplit split = EnvironmentSplit::Energy;
+    float widestSpreadDegrees = 0; ///< the largest region's √spread2
+    double splitSeconds = 0;       ///< the median cut and the surfaces' table
+    double prepareSeconds = 0;     ///< the regions' global terms (one after another)
+    std::size_t reusedLights = 0;  ///< prepared for the frame before
+    std::size_t heldBytes = 0;     ///< their caches
+    GlobalTermStats stats;         ///< the hair's queries toward the regions
+};
+
 struct SceneRender {
     Film film;
     std::optional<RasterStats> raster;       ///< the rasterized integrators'
@@ -174,6 +244,7 @@ struct SceneRender {
     std::vector<std::string> warnings;       ///< for the user (rejected shader results, ...)
     StageTimes times;
     std::vector<LightReport> lights;
+    std::optional<EnvironmentReport> environment; ///< when the scene has one
     /// Of times.globalTerm, the lights' preparation (wall time, the lights
     /// concurrently); the rest is the lookups made while shading.
     double globalTermPrepareSeconds = 0;
@@ -250,10 +321,12 @@ ComparedImage hairRadianceOf(const Film& film);
 
 /// What a path trace's samples depend on (groom content with its per-point
 /// diameters and fiber types, fiber scale, each fiber type's optics, lights,
-/// camera, surfaces and their content, background, seed, depth settings): the
+/// camera, surfaces and their content, background, the environment's pixels,
+/// colour, rotation and visibility, seed, depth settings): the
 /// key under which a run may continue another.
 std::string pathTraceHash(const Scene& scene, const SceneGroom& groom,
-                          const SceneSurfaces& surfaces);
+                          const SceneSurfaces& surfaces,
+                          const EnvironmentMap* environment = nullptr);
 
 /// The closing report: time per stage and what was skipped.
 void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& render);

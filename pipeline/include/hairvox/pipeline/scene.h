@@ -89,6 +89,25 @@ struct MeshSource {
     bool isMannequin() const { return file.empty(); }
 };
 
+/// The environment light (docs/scene.md "Environment light"): radiance from
+/// every direction, color × intensity × a latitude–longitude map (or × 1
+/// without a file), turned by `rotation` about +y (geometry/environment_map.h
+/// has the layout). At most one per scene.
+struct EnvironmentLight {
+    std::string name = "environment"; ///< as a light's (unique among the lights)
+    /// An RGB(A) EXR, resolved against the scene file's directory; empty: uniform.
+    std::filesystem::path file;
+    Rgb color{1.0f};        ///< each channel in [0, 1000]
+    float intensity = 1.0f; ///< [0, 1e6]
+    float rotation = 0;     ///< degrees about +y, right-handed, [-360, 360]
+    /// The camera sees it behind everything, in the beauty and the background
+    /// layer (instead of Scene::background). Either way it lights the scene.
+    bool visible = true;
+};
+
+/// Scene::environmentLights unless a scene says otherwise (docs/environment.md).
+inline constexpr std::uint32_t kDefaultEnvironmentLights = 8;
+
 /// Options of the `exact` global-term mode (DESIGN.md §5–6): K shadow rays per
 /// shading point from a disk of radius r perpendicular to the light.
 struct ExactSettings {
@@ -138,7 +157,12 @@ struct Scene {
     FiberScale fiberScale; ///< D (scene units: m for the procedural grooms) and k
     FiberParams fiber;
     DualScatteringParams dualScattering;
+    /// Regions of the environment map the dual-scattering integrator lights
+    /// with, each a light (docs/environment.md), [1, 1024].
+    std::uint32_t environmentLights = kDefaultEnvironmentLights;
     std::vector<Light> lights; ///< at most 16 (each adds per-light AOV layers)
+    /// The environment light, if any (an entry of the scene file's "lights").
+    std::optional<EnvironmentLight> environment;
     CameraParams camera;
     std::optional<Head> head;
     std::vector<MeshSource> meshes; ///< at most kMaxMeshes
@@ -155,7 +179,9 @@ struct Scene {
     float shadingTolerance = kDefaultShadingTolerance; ///< the adaptive rate's τ, [0, 1]
     /// T_tail of the fragment and adaptive rates, [0, 1] (render/fragment_shader.h)
     float tailTransmittance = kDefaultTailTransmittance;
-    Rgb background{0.0f}; ///< radiance behind everything, each channel in [0, 1e6]
+    /// Radiance behind everything, each channel in [0, 1e6] (a visible
+    /// environment takes its place).
+    Rgb background{0.0f};
     OutputSettings output;
 
     /// Re-checks every field and the cross-field rules (camera outside the

@@ -36,7 +36,8 @@
 //
 // The film (film/film.h) gets: the beauty "" and alpha "A"; the shader's
 // radiance layers; the surfaces' radiance (kSurfaceLayer) and the background
-// seen through everything (kBackgroundLayer) — all premultiplied, and
+// (a colour, or a BackgroundLayer per pixel: an environment) seen through
+// everything (kBackgroundLayer) — all premultiplied, and
 //     beauty = Σ shader radiance layers + surface + background;
 // the hair's share of the alpha (kHairAlphaLayer); the depth (kDepthLayer,
 // camera-space z averaged with the compositing weights, 0 where empty); and
@@ -90,6 +91,16 @@ struct SurfaceLayer {
     bool empty() const { return coverage.empty(); }
 };
 
+/// What the camera sees behind everything, per pixel (row-major, the
+/// camera's resolution): an environment seen through the pixel, averaged over
+/// it (premultiplied by nothing: each pixel's transmittance weighs it). Empty:
+/// RasterSettings::background everywhere.
+struct BackgroundLayer {
+    LargeBuffer<Rgb> radiance;
+
+    bool empty() const { return radiance.empty(); }
+};
+
 struct RasterSettings {
     FiberScale fiberScale; ///< ribbons k·D (k·D_i) wide: a strand's coverage counts k hairs
     ShadingRate shadingRate = ShadingRate::Fragment;
@@ -97,7 +108,7 @@ struct RasterSettings {
     /// when the midpoint's radiance is within this fraction of the segment's
     /// mean radiance from the ends' interpolation (fragment_shader.h). [0, 1]
     float shadingTolerance = kDefaultShadingTolerance;
-    Rgb background{0.0f}; ///< radiance behind everything
+    Rgb background{0.0f}; ///< radiance behind everything (where no BackgroundLayer is given)
     /// A pixel is opaque once its transmittance is ≤ this: fragments behind it
     /// are skipped. Their share of the pixel is at most this value. [0, 1)
     float opaqueTransmittance = 1.0f / 256.0f;
@@ -158,10 +169,12 @@ struct RasterOutput {
 };
 
 /// Rasterizes `groom` as the camera sees it, shaded by `shader`, over the
-/// opaque `surfaces` (empty: none). Polls throwIfInterrupted() between tiles
-/// and shader batches. Throws InputError for invalid settings or a surface
-/// layer of the wrong size; segments with non-finite projections are culled.
+/// opaque `surfaces` (empty: none) and the `background` (empty: the settings'
+/// colour). Polls throwIfInterrupted() between tiles and shader batches.
+/// Throws InputError for invalid settings or a surface or background layer of
+/// the wrong size; segments with non-finite projections are culled.
 RasterOutput rasterize(const Groom& groom, const Camera& camera, const FragmentShader& shader,
-                       const RasterSettings& settings, const SurfaceLayer& surfaces = {});
+                       const RasterSettings& settings, const SurfaceLayer& surfaces = {},
+                       const BackgroundLayer& background = {});
 
 } // namespace hairvox

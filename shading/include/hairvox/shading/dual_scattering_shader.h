@@ -101,7 +101,13 @@ public:
                          const DualScatteringParams& params);
 
     /// Adds the current light's E·ShadeResult to every point of the batch.
-    void shade(ShadeBatch& batch) const;
+    /// `spread2`: the light's angular variance per axis (rad²) when it stands
+    /// for an area — a region of an environment map (EnvironmentRegion::
+    /// spread2) — whose directions spread θ_i: every longitudinal lobe (M_p,
+    /// M^G_p, S̄_b) is widened by the θ_h variance it causes, spread2/4, the
+    /// lobe convolved with a Gaussian of the light's extent (its azimuthal
+    /// extent is neglected: N_p is broad in φ). 0: a directional light.
+    void shade(ShadeBatch& batch, float spread2 = 0) const;
 
     /// ω_i toward the light, ω_o toward the camera, u the unit tangent; all unit.
     ShadeResult shade(const Vec3f& wi, const Vec3f& wo, const Vec3f& u, const GlobalTerm& g) const;

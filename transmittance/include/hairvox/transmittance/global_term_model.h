@@ -27,6 +27,7 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <vector>
 
 namespace hairvox {
 
@@ -148,6 +149,32 @@ public:
 ///   sumBeta2    expected Σβ̄_f² over crossings          → σ_f² = sumBeta2 / (1 − V)
 /// T_s = d_f·(P − V) ≥ 0, continuous as n → 0.
 GlobalTerm globalTermFromDepths(float n, const Rgb& tauP, const Rgb& sumBeta2, float d_f);
+
+/// The samples along the fibers that alongFibers() evaluates for a batch of
+/// queries, and how each query is interpolated from them. Planned once, it
+/// serves every light sampled with the same spacing (an environment's
+/// regions: their planning was a tenth of such a render, once per region).
+class FiberSamplePlan {
+public:
+    /// Plans `queries` as alongFibers() does (`spacing` in world units, > 0).
+    void plan(std::span<const GlobalTermQuery> queries, const Groom& groom, float spacing);
+    /// The points to evaluate.
+    std::span<const GlobalTermQuery> samples() const { return samples_; }
+    /// out[j], the global term at query j, from the samples' values
+    /// (values.size() == samples().size(), out.size() == the queries').
+    void interpolate(std::span<const GlobalTerm> values, std::span<GlobalTerm> out) const;
+
+private:
+    /// Per query: the sample at or below it (an index into samples_) and the
+    /// fraction toward the next one.
+    struct Where {
+        std::uint32_t sample;
+        float f;
+    };
+    std::vector<GlobalTermQuery> samples_;
+    std::vector<Where> where_; ///< every element written before it is read
+    std::vector<int> needed_;  ///< sample numbers along the current segment
+};
 
 /// Wraps a per-light evaluation so that a point on a fiber segment
 /// (GlobalTermQuery::segment) gets the global term interpolated linearly

@@ -1,0 +1,114 @@
+#include "environment_lights.h"
+
+#include <hairvox/core/error.h>
+#include <hairvox/core/math.h>
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+namespace hairvox::detail {
+
+namespace {
+
+/// The normal of table node (x, y).
+Vec3f nodeNormal(int x, int y) {
+    const double theta = Pi * y / (RegionIrradiance::kNormalsY - 1);
+    const double phi = TwoPi * x / RegionIrradiance::kNormalsX;
+    return {float(std::sin(theta) * std::cos(phi)), float(std::cos(theta)),
+            float(std::sin(theta) * std::sin(phi))};
+}
+
+} // namespace
+
+RegionIrradiance::RegionIrradiance(const EnvironmentMap& map,
+                                   std::span<const EnvironmentRegion> regions,
+                                   std::size_t subdivisions)
+    : regions_(regions.size())
+    , table_(regions.size() * std::size_t(kNormalsX * kNormalsY)) {
+    tbb::parallel_for(std::size_t(0), regions.size(), [&](std::size_t k) {
+        const std::vector<EnvironmentRegion> parts =
+            map.split(std::max<std::size_t>(subdivisions, 1), EnvironmentSplit::Energy, regions[k]);
+        Node* nodes = table_.data() + k * std::size_t(kNormalsX * kNormalsY);
+        for (int y = 0; y < kNormalsY; ++y)
+            for (int x = 0; x < kNormalsX; ++x) {
+                const Vec3f n = nodeNormal(x, y);
+                Rgbd irradiance(0.0);
+                Vec3d direction(0.0);
+                for (const EnvironmentRegion& part : parts) {
+                    const float cosine = glm::dot(n, part.direction);
+                    if (!(cosine > 0))
+                        continue;
+                    irradiance += Rgbd(part.irradiance) * double(cosine);
+                    direction +=
+                        double(part.irradiance.luminance() * cosine) * Vec3d(part.direction);
+                }
+                nodes[y * kNormalsX + x] = {Rgb(irradiance), Vec3f(direction)};
+            }
+    });
+}
+
+RegionIrradiance::Value RegionIrradiance::at(std::size_t region, const Vec3f& n) const {
+    const float theta = safeACos(std::clamp(n.y, -1.0f, 1.0f));
+    float phi = std::atan2(n.z, n.x);
+    if (phi < 0)
+        phi += float(TwoPi);
+    const float fx = phi * float(kNormalsX / TwoPi), fy = theta * float((kNormalsY - 1) / Pi);
+    const int x0 = std::min(int(fx), kNormalsX - 1), y0 = std::min(int(fy), kNormalsY - 2);
+    const int x1 = (x0 + 1) % kNormalsX, y1 = y0 + 1;
+    const float tx = std::clamp(fx - float(x0), 0.0f, 1.0f),
+                ty = std::clamp(fy - float(y0), 0.0f, 1.0f);
+    const Node* nodes = table_.data() + region * std::size_t(kNormalsX * kNormalsY);
+    const auto node = [&](int x, int y) -> const Node& {
+        return nodes[y * kNormalsX + x];
+    };
+    const float w00 = (1 - tx) * (1 - ty), w10 = tx * (1 - ty), w01 = (1 - tx) * ty, w11 = tx * ty;
+    Value v;
+    v.irradiance = w00 * node(x0, y0).irradiance + w10 * node(x1, y0).irradiance +
+                   w01 * node(x0, y1).irradiance + w11 * node(x1, y1).irradiance;
+    v.direction = normalizeOr(w00 * node(x0, y0).direction + w10 * node(x1, y0).direction +
+                                  w01 * node(x0, y1).direction + w11 * node(x1, y1).direction,
+                              n);
+    return v;
+}
+
+EnvironmentLighting environmentLighting(const EnvironmentMap& map, const std::string& name,
+                                        std::size_t count, EnvironmentSplit by,
+                                        std::size_t subdivisions) {
+    EnvironmentLighting out;
+    out.regions = map.split(count, by);
+    for (std::size_t k = 0; k < out.regions.size(); ++k) {
+        const EnvironmentRegion& r = out.regions[k];
+        Light light = Light::directional(r.direction);
+        light.name = strCat(name, ".", k);
+        light.color = r.irradiance;
+        light.intensity = 1.0f;
+        out.lights.push_back(light);
+        out.spread2.push_back(r.spread2);
+    }
+    out.surfaces = RegionIrradiance(map, out.regions, subdivisions);
+    return out;
+}
+
+BackgroundLayer backgroundLayer(const EnvironmentMap& map, const Camera& camera) {
+    const int width = camera.width(), height = camera.height();
+    BackgroundLayer layer;
+    layer.radiance = LargeBuffer<Rgb>(std::size_t(width) * std::size_t(height));
+    tbb::parallel_for(0, height, [&](int y) {
+        for (int x = 0; x < width; ++x) {
+            Rgb sum(0.0f);
+            for (int k = 0; k < 4; ++k) {
+                const Vec2f raster(float(x) + 0.25f + 0.5f * float(k & 1),
+                                   float(y) + 0.25f + 0.5f * float(k >> 1));
+                sum += map.backdrop(camera.toWorldDirection(camera.rayDirection(raster)));
+            }
+            std::construct_at(&layer.radiance[std::size_t(y) * std::size_t(width) + std::size_t(x)],
+                              0.25f * sum);
+        }
+    });
+    return layer;
+}
+
+} // namespace hairvox::detail
