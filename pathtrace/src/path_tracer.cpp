@@ -6,6 +6,7 @@
 #include <hairvox/core/parallel.h>
 #include <hairvox/core/progress.h>
 #include <hairvox/core/rng.h>
+#include <hairvox/core/sampling.h>
 #include <hairvox/geometry/ray_scene.h>
 #include <hairvox/pathtrace/path_tracer.h>
 #include <hairvox/shading/marschner.h>
@@ -116,15 +117,6 @@ struct Counters {
     double energyAtCap = 0;
 };
 
-/// A unit vector from the cosine-weighted hemisphere about n (Malley's method).
-Vec3f cosineDirection(const Vec3f& n, float u1, float u2) {
-    const float r = std::sqrt(u1), phi = static_cast<float>(TwoPi) * u2;
-    Vec3f s, t;
-    coordinateSystem(n, s, t);
-    return glm::normalize(r * std::cos(phi) * s + r * std::sin(phi) * t +
-                          std::sqrt(std::max(0.0f, 1.0f - u1)) * n);
-}
-
 class Tracer {
 public:
     Tracer(const PathTraceScene& scene, const PathTraceSettings& settings)
@@ -149,12 +141,8 @@ public:
         // The pixel position: R2 (Roberts 2018), rotated per pixel and half.
         const std::uint32_t half = index & 1u;
         const std::uint64_t rotation = Hasher().value(settings_.seed).value(pixel).value(half).digest();
-        constexpr double a1 = 0.7548776662466927, a2 = 0.5698402909980532;
-        const double r1 = double(rotation & 0xffffffffu) * 0x1p-32;
-        const double r2 = double(rotation >> 32) * 0x1p-32;
-        const double k = double(index >> 1) + 1.0;
-        const Vec2f raster(float(x) + float(std::fmod(r1 + k * a1, 1.0)),
-                           float(y) + float(std::fmod(r2 + k * a2, 1.0)));
+        const Vec2f raster =
+            Vec2f(float(x), float(y)) + r2Point(double(index >> 1) + 1.0, rotation);
         const Vec3f dirCam = camera_.rayDirection(raster);
         Vec3f dir = camera_.toWorldDirection(dirCam);
         // Geometry nearer than the near plane is clipped, as in the rasterizer.
@@ -310,7 +298,7 @@ public:
                 }
                 throughput *= albedo;
                 origin = xOff;
-                dir = cosineDirection(n, rng.uniformFloat(), rng.uniformFloat());
+                dir = cosineHemisphere(n, rng.uniformFloat(), rng.uniformFloat());
                 if (!(glm::dot(dir, ng) > 0))
                     break; // below the surface: the shading normal's lobe dips under it
                 continuationPdf = glm::dot(n, dir) * float(InvPi);

@@ -608,10 +608,10 @@ Scene parseScene(const nlohmann::json& document, const std::string& sourceName,
                 if (!x.present())
                     return;
                 if (std::find(owners.begin(), owners.end(), scene.integrator) == owners.end()) {
-                    std::string names;
+                    std::string owning;
                     for (const Integrator o : owners)
-                        names += strCat(names.empty() ? "" : " and ", "\"", toString(o), "\"");
-                    x.fail(strCat("applies to the ", names, " integrator",
+                        owning += strCat(owning.empty() ? "" : " and ", "\"", toString(o), "\"");
+                    x.fail(strCat("applies to the ", owning, " integrator",
                                   owners.size() > 1 ? "s" : "", " only (\"type\")"));
                 }
                 assign(x);

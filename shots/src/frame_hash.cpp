@@ -54,6 +54,9 @@ void hashSceneInto(Hasher& h, const Scene& s) {
         for (const Rgb& c : p.colors)
             h.value(c);
     }
+    h.value(s.groom.inMemory != nullptr); // (the Python module's) by its contents
+    if (s.groom.inMemory)
+        h.value(contentHash(*s.groom.inMemory));
     h.value(s.groom.thickness).value(s.groom.color);
     s.fiberScale.hashInto(h);
     s.fiber.hashInto(h);
@@ -75,6 +78,12 @@ void hashSceneInto(Hasher& h, const Scene& s) {
             h.value(m.mannequin.center).value(m.mannequin.radius).value(m.mannequinRings);
         h.value(m.transform.scale).value(m.transform.rotateDegrees).value(m.transform.translate);
         h.value(m.albedo);
+    }
+    h.value(s.environment.has_value()).value(s.environmentLights);
+    if (s.environment) { // its file's contents in frameHash()
+        const EnvironmentLight& e = *s.environment;
+        h.string(e.name).value(e.file.empty()).value(e.color).value(e.intensity);
+        h.value(e.rotation).value(e.visible);
     }
     h.value(s.voxelSize.has_value()).value(s.voxelSize.value_or(0.0f));
     h.value(s.fiberSampleSpacing.has_value()).value(s.fiberSampleSpacing.value_or(0.0f));
@@ -103,8 +112,10 @@ std::string frameHash(const Scene& scene, int frame, FileDigests& files) {
     h.string(version());
     h.value(frame);
     hashSceneInto(h, scene);
-    if (!scene.groom.isProcedural())
+    if (!scene.groom.file.empty())
         h.value(files.of(scene.groom.file));
+    if (scene.environment && !scene.environment->file.empty())
+        h.value(files.of(scene.environment->file));
     for (const MeshSource& m : scene.meshes)
         if (!m.isMannequin())
             h.value(files.of(m.file));

@@ -128,11 +128,8 @@ private:
         Pcg32 rng(Hasher().value(settings_.seed).value(e.index).value(j).digest());
         // The start: the j-th point of R2 (Roberts 2018), shifted per light.
         const std::uint64_t shift = Hasher().value(settings_.seed).value(e.index).digest();
-        constexpr double a1 = 0.7548776662466927, a2 = 0.5698402909980532;
-        const double k = double(j) + 1.0;
-        const LightEmission::Start start = e.emission->start(
-            float(std::fmod(double(shift & 0xffffffffu) * 0x1p-32 + k * a1, 1.0)),
-            float(std::fmod(double(shift >> 32) * 0x1p-32 + k * a2, 1.0)), e.count);
+        const Vec2f u = r2Point(double(j) + 1.0, shift);
+        const LightEmission::Start start = e.emission->start(u.x, u.y, e.count);
         Ray ray{start.origin, start.dir};
         Rgb power = start.power;
         const float roulette = 1.0f / power.maxComponent();
@@ -328,9 +325,10 @@ MultipleScatteringSolution solveMultipleScattering(const VolumetricScene& scene,
     stats.pathsPerLight.assign(scene.lights.size(), 0);
     if (scene.surfaces && !scene.surfaces->empty() && cache.cellCount() > 0) {
         // The surfaces within a cell of the hair's cells.
+        const CellGrid& cells = cache.cells();
         out.surfaces = std::make_unique<SurfaceIrradiance>(
-            *scene.surfaces, float(scene.grid->info.voxelSize), settings.cache.cellVoxels,
-            cache.boxMin() - 1, cache.boxDims() + 2);
+            *scene.surfaces, CellGrid(cells.voxelSize(), cells.cellVoxels(), cells.boxMin() - 1,
+                                      cells.boxDims() + 2));
         stats.surfaceCells = out.surfaces->cellCount();
     }
 

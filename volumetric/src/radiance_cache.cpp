@@ -22,18 +22,14 @@ constexpr std::uint64_t kMaxIndexCells = 1ull << 30;
 /// cell, or it is taken from the 3³ neighbourhood.
 constexpr double kMinCoherence = 0.05;
 
-int floorDiv(int a, int b) {
-    return a >= 0 ? a / b : -((-a + b - 1) / b);
-}
-
 /// The box (first cell, cells a side) of the cells holding the grid's blocks.
 std::pair<glm::ivec3, glm::ivec3> cellBox(const FiberGrid& grid, int m) {
     glm::ivec3 lo(std::numeric_limits<int>::max()), hi(std::numeric_limits<int>::min());
     for (const FiberBlock& b : grid.blocks) {
         const glm::ivec3 o(b.origin.x(), b.origin.y(), b.origin.z());
         for (int i = 0; i < 3; ++i) {
-            lo[i] = std::min(lo[i], floorDiv(o[i], m));
-            hi[i] = std::max(hi[i], floorDiv(o[i] + FiberBlock::kDim - 1, m));
+            lo[i] = std::min(lo[i], CellGrid::floorDiv(o[i], m));
+            hi[i] = std::max(hi[i], CellGrid::floorDiv(o[i] + FiberBlock::kDim - 1, m));
         }
     }
     return {lo, hi - lo + 1};
@@ -75,7 +71,6 @@ std::uint64_t RadianceCache::estimateBytes(const FiberGrid& grid,
 RadianceCache::RadianceCache(const FiberGrid& grid, const RadianceCacheSettings& settings,
                              std::uint64_t memoryBudget)
     : settings_(settings)
-    , h_(float(grid.info.voxelSize))
     , types_(grid.fiberTypeCount()) {
     settings.validate();
     if (grid.blocks.empty())
@@ -90,42 +85,30 @@ RadianceCache::RadianceCache(const FiberGrid& grid, const RadianceCacheSettings&
             " MiB, over the ", memoryBudget >> 20, " MiB the render can give it; raise "
             "integrator.cell_voxels or the voxel size, or lower integrator.theta_bins / "
             "azimuthal_order"));
-    cellMin_ = lo;
-    dims_ = dims;
-    const auto boxIndex = [&](const glm::ivec3& c) {
-        const glm::ivec3 r = c - cellMin_;
-        return (std::size_t(r.x) * std::size_t(dims_.y) + std::size_t(r.y)) * std::size_t(dims_.z) +
-               std::size_t(r.z);
-    };
-    const auto cellOfVoxel = [m](const openvdb::Coord& v) {
-        return glm::ivec3(floorDiv(v.x(), m), floorDiv(v.y(), m), floorDiv(v.z(), m));
+    grid_ = CellGrid(float(grid.info.voxelSize), m, lo, dims);
+    const auto boxIndex = [&](const glm::ivec3& c) { return std::size_t(grid_.boxIndex(c)); };
+    const auto cellOfVoxel = [&](const openvdb::Coord& v) {
+        return grid_.cellOfVoxel(glm::ivec3(v.x(), v.y(), v.z()));
     };
 
     // The cells holding fibers, in the order of their box index.
-    std::vector<std::uint8_t> mark(boxCells(dims_), 0);
+    std::vector<std::uint8_t> mark(grid_.boxCells(), 0);
     grid.forEachVoxel([&](std::size_t, const openvdb::Coord& v) { mark[boxIndex(cellOfVoxel(v))] = 1; });
-    index_.assign(mark.size(), -1);
-    for (std::size_t i = 0; i < mark.size(); ++i)
-        if (mark[i] != 0) {
-            index_[i] = static_cast<std::int32_t>(cells_.size());
-            const auto iz = int(i % std::size_t(dims_.z));
-            const auto iy = int((i / std::size_t(dims_.z)) % std::size_t(dims_.y));
-            const auto ix = int(i / (std::size_t(dims_.z) * std::size_t(dims_.y)));
-            cells_.push_back(cellMin_ + glm::ivec3(ix, iy, iz));
-        }
+    for (const std::size_t i : grid_.makePresent(mark))
+        cells_.push_back(grid_.cellOfBoxIndex(i));
 
     // Λ and the frames from the fibers' length and mean tangents.
     std::vector<Vec3d> sumO(cells_.size(), Vec3d(0.0));
     std::vector<double> sumL(cells_.size(), 0.0);
     grid.forEachVoxel([&](std::size_t v, const openvdb::Coord& ijk) {
-        const auto slot = std::size_t(index_[boxIndex(cellOfVoxel(ijk))]);
+        const auto slot = std::size_t(grid_.slotOfCell(cellOfVoxel(ijk)));
         const openvdb::Vec3s& o = grid.orientation[v];
         sumO[slot] += double(grid.density[v]) * Vec3d(o.x(), o.y(), o.z());
         sumL[slot] += double(grid.density[v]);
     });
     frames_.resize(cells_.size());
     fiberLength_.resize(cells_.size());
-    const double voxelVolume = double(h_) * double(h_) * double(h_);
+    const double h = double(grid_.voxelSize()), voxelVolume = h * h * h;
     for (std::size_t s = 0; s < cells_.size(); ++s) {
         fiberLength_[s] = float(sumL[s] * voxelVolume);
         Vec3d o = sumO[s];
@@ -136,7 +119,7 @@ RadianceCache::RadianceCache(const FiberGrid& grid, const RadianceCacheSettings&
             for (int dx = -1; dx <= 1; ++dx)
                 for (int dy = -1; dy <= 1; ++dy)
                     for (int dz = -1; dz <= 1; ++dz) {
-                        const std::int64_t n = slotOfCell(cells_[s] + glm::ivec3(dx, dy, dz));
+                        const std::int64_t n = grid_.slotOfCell(cells_[s] + glm::ivec3(dx, dy, dz));
                         if (n >= 0) {
                             o += sumO[std::size_t(n)];
                             l += sumL[std::size_t(n)];
@@ -152,34 +135,18 @@ RadianceCache::RadianceCache(const FiberGrid& grid, const RadianceCacheSettings&
     coefficients_.assign(cells_.size() * floatsPerCell(), 0.0f);
 }
 
-
-
-std::int64_t RadianceCache::slotOfCell(const glm::ivec3& cell) const {
-    const glm::ivec3 r = cell - cellMin_;
-    if (r.x < 0 || r.y < 0 || r.z < 0 || r.x >= dims_.x || r.y >= dims_.y || r.z >= dims_.z)
-        return -1;
-    return index_[(std::size_t(r.x) * std::size_t(dims_.y) + std::size_t(r.y)) *
-                      std::size_t(dims_.z) +
-                  std::size_t(r.z)];
-}
-
-std::int64_t RadianceCache::slotAt(const Vec3f& x) const {
-    const Vec3f q = cacheCoordinates(x);
-    return slotOfCell(glm::ivec3(floorToInt(q.x), floorToInt(q.y), floorToInt(q.z)));
-}
-
 Bounds3f RadianceCache::bounds() const {
     Bounds3f b;
     if (cells_.empty())
         return b;
-    const float size = cellSize();
-    b.extend(Vec3f(cellMin_) * size - 0.5f * h_);
-    b.extend(Vec3f(cellMin_ + dims_) * size - 0.5f * h_);
+    const float size = cellSize(), h = grid_.voxelSize();
+    b.extend(Vec3f(grid_.boxMin()) * size - 0.5f * h);
+    b.extend(Vec3f(grid_.boxMin() + grid_.boxDims()) * size - 0.5f * h);
     return b;
 }
 
 std::uint64_t RadianceCache::memoryBytes() const {
-    std::uint64_t bytes = index_.capacity() * sizeof(std::int32_t) +
+    std::uint64_t bytes = grid_.memoryBytes() +
                           cells_.capacity() * sizeof(glm::ivec3) +
                           frames_.capacity() * sizeof(FiberFrame) +
                           fiberLength_.capacity() * sizeof(float) +
@@ -190,8 +157,7 @@ std::uint64_t RadianceCache::memoryBytes() const {
 }
 
 std::int64_t RadianceCache::slotOfVoxel(const glm::ivec3& v) const {
-    const int m = settings_.cellVoxels;
-    return slotOfCell(glm::ivec3(floorDiv(v.x, m), floorDiv(v.y, m), floorDiv(v.z, m)));
+    return grid_.slotOfCell(grid_.cellOfVoxel(v));
 }
 
 void RadianceCache::deposit(std::uint32_t slot, const Vec3f& omega_i, const Rgb& power) {
@@ -259,29 +225,17 @@ Rgb RadianceCache::outgoing(const Vec3f& x, const Vec3f& u, const Vec3f& omega_o
             out[ch] += w * v;
         }
     };
-    const Vec3f q = cacheCoordinates(x) - 0.5f;
-    const glm::ivec3 base(floorToInt(q.x), floorToInt(q.y), floorToInt(q.z));
-    const Vec3f f = q - Vec3f(base);
     Rgb sum(0.0f);
-    float weights = 0;
-    for (int corner = 0; corner < 8; ++corner) {
-        const glm::ivec3 o((corner >> 2) & 1, (corner >> 1) & 1, corner & 1);
-        const std::int64_t slot = slotOfCell(base + o);
-        if (slot < 0)
-            continue;
-        const float w = (o.x ? f.x : 1.0f - f.x) * (o.y ? f.y : 1.0f - f.y) * (o.z ? f.z : 1.0f - f.z);
-        if (!(w > 0))
-            continue;
-        const FiberFrame& frame = frames_[std::size_t(slot)];
-        const std::size_t offset = std::size_t(slot) * n;
+    const float weights = grid_.forEachAround(x, [&](std::size_t slot, float w) {
+        const FiberFrame& frame = frames_[slot];
+        const std::size_t offset = slot * n;
         // Backward lobes in the fragment's own frame, the forward lobe in the
         // cell's (the file comment).
         read(backward + offset,
              AzimuthalHarmonics::of(omega_o, FiberFrame::along(u, frame), basis.azimuthalOrder),
              sum, w);
         read(forward + offset, AzimuthalHarmonics::of(omega_o, frame, basis.azimuthalOrder), sum, w);
-        weights += w;
-    }
+    });
     if (!(weights > 0))
         return Rgb(0.0f);
     sum /= weights;
@@ -293,22 +247,11 @@ Rgb RadianceCache::incident(const Vec3f& x, const Vec3f& omega_i) const {
         return Rgb(0.0f);
     const RadianceBasis& basis = settings_.basis;
     const int perBin = basis.coefficientsPerBin();
-    const Vec3f q = cacheCoordinates(x) - 0.5f;
-    const glm::ivec3 base(floorToInt(q.x), floorToInt(q.y), floorToInt(q.z));
-    const Vec3f f = q - Vec3f(base);
     Rgb sum(0.0f);
-    float weights = 0;
-    for (int corner = 0; corner < 8; ++corner) {
-        const glm::ivec3 o((corner >> 2) & 1, (corner >> 1) & 1, corner & 1);
-        const std::int64_t slot = slotOfCell(base + o);
-        if (slot < 0)
-            continue;
-        const float w = (o.x ? f.x : 1.0f - f.x) * (o.y ? f.y : 1.0f - f.y) * (o.z ? f.z : 1.0f - f.z);
-        if (!(w > 0))
-            continue;
+    const float weights = grid_.forEachAround(x, [&](std::size_t slot, float w) {
         const AzimuthalHarmonics h =
-            AzimuthalHarmonics::of(omega_i, frames_[std::size_t(slot)], basis.azimuthalOrder);
-        const float* c = coefficients_.data() + std::size_t(slot) * floatsPerCell() +
+            AzimuthalHarmonics::of(omega_i, frames_[slot], basis.azimuthalOrder);
+        const float* c = coefficients_.data() + slot * floatsPerCell() +
                          std::size_t(basis.bin(h.s)) * std::size_t(perBin);
         for (int ch = 0; ch < 3; ++ch) {
             float v = 0;
@@ -317,8 +260,7 @@ Rgb RadianceCache::incident(const Vec3f& x, const Vec3f& omega_i) const {
                      h.harmonic[std::size_t(m)];
             sum[ch] += w * v;
         }
-        weights += w;
-    }
+    });
     return weights > 0 ? sum / weights : Rgb(0.0f);
 }
 

@@ -7,8 +7,18 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 namespace hairvox {
+
+/// The k-th point (k ≥ 1) of the R2 sequence in [0, 1)² (Roberts 2018: the
+/// additive recurrence on the powers of the plastic number's inverse), shifted
+/// by `shift` read as two 32-bit fractions (Cranley–Patterson rotation).
+inline Vec2f r2Point(double k, std::uint64_t shift) {
+    constexpr double a1 = 0.7548776662466927, a2 = 0.5698402909980532;
+    return {float(std::fmod(double(shift & 0xffffffffu) * 0x1p-32 + k * a1, 1.0)),
+            float(std::fmod(double(shift >> 32) * 0x1p-32 + k * a2, 1.0))};
+}
 
 /// A unit vector uniformly distributed on the sphere (density 1/(4π)) from
 /// u1, u2 ∈ [0, 1).

@@ -2,7 +2,7 @@
 // surfaces near the hair (docs/DESIGN.md §9: surfaces take part in the
 // transport both ways) — skin lit by the light the hair scatters onto it.
 //
-// Per cell of the radiance cache's grid (radiance_cache.h: m voxels a side)
+// Per cell of the radiance cache's grid (cell_grid.h: m voxels a side)
 // within one cell of the hair: the surfaces' area A in the cell, and the
 // power Φ that light paths bring onto it after their first scattering. A
 // path that meets a surface there deposits its power, and
@@ -22,6 +22,7 @@
 
 #include <hairvox/core/rgb.h>
 #include <hairvox/core/vecmath.h>
+#include <hairvox/volumetric/cell_grid.h>
 
 #include <cstdint>
 #include <vector>
@@ -32,31 +33,21 @@ class SurfaceScene;
 
 class SurfaceIrradiance {
 public:
-    /// Cells of side m·h (world box of cell C: [(m·C − ½)·h, (m·C + m − ½)·h))
-    /// holding surface within the cells [cellMin, cellMin + dims).
-    SurfaceIrradiance(const SurfaceScene& surfaces, float voxelSize, int cellVoxels,
-                      const glm::ivec3& cellMin, const glm::ivec3& dims);
+    /// The cells of `box` (its present cells ignored) that hold surface.
+    SurfaceIrradiance(const SurfaceScene& surfaces, const CellGrid& box);
 
     std::size_t cellCount() const { return area_.size(); }
     std::uint64_t memoryBytes() const;
 
     /// The slot of the cell holding x, or -1 (no surface there, or outside).
-    std::int64_t slotAt(const Vec3f& x) const;
+    std::int64_t slotAt(const Vec3f& x) const { return grid_.slotAt(x); }
     /// Adds power Φ arriving on the surface in the cell. Not thread-safe for one slot.
     void deposit(std::uint32_t slot, const Rgb& power) { irradiance_[slot] += power / area_[slot]; }
     /// The mean irradiance on the surface around x; 0 away from the cells.
     Rgb irradiance(const Vec3f& x) const;
 
 private:
-    std::int64_t slotOfCell(const glm::ivec3& cell) const;
-    Vec3f cacheCoordinates(const Vec3f& x) const {
-        return (x / h_ + 0.5f) / float(cellVoxels_);
-    }
-
-    float h_ = 1;
-    int cellVoxels_ = 1;
-    glm::ivec3 cellMin_{0}, dims_{0};
-    std::vector<std::int32_t> index_; ///< dense over the box: slot or -1
+    CellGrid grid_;
     std::vector<float> area_;         ///< per slot
     std::vector<Rgb> irradiance_;     ///< per slot
 };
