@@ -51,6 +51,9 @@ struct EnvironmentOptions {
     /// Sub-regions a region is cut into for what surfaces see of it
     /// (environment_lights.h RegionIrradiance).
     std::size_t surfaceSubdivisions = 16; ///< [1, 4096]
+    /// Rays a sample on the hair casts per region for the surfaces' shadow
+    /// (detail::RegionSurfaceShadow), [1, 64].
+    std::size_t hairShadowRays = 4;
     /// Widen the fiber's lobes by each region's angular spread; false: every
     /// region a directional light.
     bool spread = true;
