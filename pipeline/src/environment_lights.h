@@ -9,8 +9,8 @@
 // the region's angular spread (DualScatteringShader::shade's spread2), so
 // that a region's R highlight is as wide as the region rather than a copy of
 // the lobe per light. The surfaces' shadow on the hair is the share of the
-// region's light they leave, from a few rays per point along the region cut
-// again by energy (RegionSurfaceShadow).
+// region's light they leave, from EnvironmentOptions::hairShadowRays rays per
+// point along the region cut again by energy (RegionSurfaceShadow).
 //
 // Surfaces (Lambertian). A region's light reaches a surface point with normal
 // n as E_k(n) = ∫_region L(ω) max(0, n·ω) dω — part of a region may lie below
@@ -97,8 +97,9 @@ EnvironmentLighting environmentLighting(const EnvironmentMap& map, const std::st
 /// region cut again by energy, EnvironmentLighting::shadowDirections), each
 /// weighing its share of the region's luminance. A region of the sky half
 /// behind a body lights hair lying on the body by half, where one ray along
-/// its mean direction gave all or nothing (Ratboy's mohawk lying on its back
-/// under studio.exr, 8 regions: docs/environment.md). The result is the
+/// its mean direction gives all or nothing (Ratboy's mohawk on its body under
+/// sky.exr, 8 regions: 4 rays took the error against the path tracer from
+/// 0.431 to 0.404, at 1.5x the CPU time; docs/environment.md). The result is the
 /// mixture of `inner`'s term (the share) and GlobalTerm::blocked() (the
 /// rest): V, P and T_s scaled by the share, σ_f² (conditioned on a
 /// crossing) kept; a point no ray leaves is blocked without being evaluated.
