@@ -14,12 +14,13 @@
 //               spacings) on the default scene under studio, sky and city,
 //               against the path tracer: rel. L1 of the hair's radiance over
 //               8×8 blocks with the reference's noise removed, and the time
-//   ratboy      Ratboy's mohawk on its body under studio.exr, dual
-//               scattering (grid) against the path tracer, beside the same
-//               under its two directional lights
+//   ratboy      Ratboy's mohawk on its body under studio.exr and sky.exr,
+//               dual scattering (grid) against the path tracer, beside the
+//               same under its two directional lights; the hair's surface
+//               shadow from 4 rays a region against the default
 //   noise       the path tracer's noise floor under sky.exr against
 //               city.exr at equal time
-//   regions     what the regions cost at 1024² (K, spacings): wall and CPU
+//   regions     what the regions cost at 1024² (K, shadow rays, spacings): wall and CPU
 //               time, preparation, lookups, shading, in this process
 //   cost        the default scene at 1024², grid mode: lit by studio.exr
 //               against its two directional lights — wall time and peak
@@ -334,23 +335,35 @@ void ratboy(const Options& o) {
     };
     std::printf("%ux%u, grid mode, fragment rate; error: rel. L1 of the hair's radiance over "
                 "%dx%d blocks against a %u-spp path trace, its noise removed; single: the "
-                "direct_* layers alone (no noise estimate)\n\n",
+                "direct_* layers alone, rel. L1 and bias (no noise estimate)\n\n",
                 size, size, kBlock, kBlock, spp);
-    std::printf("%-34s %-58s %-8s %7s\n", "lighting", "error", "single", "seconds");
-    for (const auto& [label, file, name] :
-         {std::tuple{"its two lights (ratboy_mohawk)", "ratboy_mohawk.json", "ratboy_lights"},
-          std::tuple{"studio.exr (ratboy_studio)", "ratboy_studio.json", "ratboy_studio"},
-          std::tuple{"sky.exr (ratboy_sky)", "ratboy_sky.json", "ratboy_sky"}}) {
-        const Scene scene = prepare(file);
-        const Film ref = reference(scene, o, name, spp);
-        const Rendered ds = renderDual(scene);
+    std::printf("%-40s %-58s %-16s %7s\n", "lighting", "error", "single", "seconds");
+    struct Row {
+        const char* label;
+        const char* file;
+        const char* name;
+        std::size_t hairShadowRays;
+    };
+    const std::size_t rays = EnvironmentOptions{}.hairShadowRays;
+    for (const Row& row :
+         {Row{"its two lights (ratboy_mohawk)", "ratboy_mohawk.json", "ratboy_lights", rays},
+          Row{"studio.exr (ratboy_studio)", "ratboy_studio.json", "ratboy_studio", rays},
+          Row{"studio.exr, 4 shadow rays a region", "ratboy_studio.json", "ratboy_studio", 4},
+          Row{"sky.exr (ratboy_sky)", "ratboy_sky.json", "ratboy_sky", rays},
+          Row{"sky.exr, 4 shadow rays a region", "ratboy_sky.json", "ratboy_sky", 4}}) {
+        const Scene scene = prepare(row.file);
+        const Film ref = reference(scene, o, row.name, spp);
+        PipelineOptions options;
+        options.environment.hairShadowRays = row.hairShadowRays;
+        const Rendered ds = renderDual(scene, options);
         const std::vector<std::string> direct = {"direct_R", "direct_TT", "direct_TRT"};
         const ImageError single =
             compareImages(ComparedImage::fromFilm(ds.film, direct, "hair.A").boxFiltered(kBlock),
                           ComparedImage::fromFilm(ref, direct, "hair.A").boxFiltered(kBlock))
                 .value_or(ImageError{});
-        std::printf("%-34s %-58s %6.3f   %7.2f\n", label,
-                    errorText(hairError(ds.film, ref, kBlock)).c_str(), single.relL1, ds.seconds);
+        std::printf("%-40s %-58s %6.3f (%+6.3f)  %7.2f\n", row.label,
+                    errorText(hairError(ds.film, ref, kBlock)).c_str(), single.relL1,
+                    single.relBias, ds.seconds);
         std::fflush(stdout);
     }
 }
@@ -423,14 +436,23 @@ void regions(const Options& o) {
         s.environmentLights = k;
         row("studio.exr, K = " + std::to_string(k), s, PipelineOptions{});
     }
+    {
+        Scene s = withEnvironment(base, "studio.exr");
+        PipelineOptions options;
+        options.environment.hairShadowRays = 4;
+        row("studio.exr, K = " + std::to_string(s.environmentLights) + ", 4 shadow rays", s,
+            options);
+    }
     for (const float spacing : {3.0f, 4.0f}) {
         Scene s = withEnvironment(base, "studio.exr");
+        s.environmentLights = 16;
         PipelineOptions options;
         options.environment.fiberSampleSpacing = spacing;
         row("studio.exr, K = 16, samples " + std::to_string(int(spacing)) + " voxels", s, options);
     }
     {
         Scene s = withEnvironment(base, "studio.exr");
+        s.environmentLights = 16;
         PipelineOptions options;
         options.environment.cacheSpacing = 4.0f;
         row("studio.exr, K = 16, cache lines 4", s, options);

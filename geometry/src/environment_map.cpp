@@ -339,16 +339,16 @@ std::vector<EnvironmentRegion> EnvironmentMap::split(std::size_t count, Environm
             }
         const double spread =
             r.weight > 0 ? std::max(0.0, 1.0 - glm::length(moment) / r.weight) : 0;
-        r.priority = r.weight * spread;
+        r.priority = r.weight * std::min(1.0, spread / double(kPointLikeSpread2));
     };
     std::vector<Rect> rects{{within.x0, within.y0, within.x1, within.y1, 0.0, 0.0}};
     weigh(rects[0]);
     std::vector<double> marginal;
     while (rects.size() < count) {
         // The rectangle whose point light would be most wrong: the largest
-        // weight × spread (its second moment about its mean direction), the
-        // first of equals. (By weight alone, a sun a few pixels wide would
-        // take a cut per halving of its rectangle, and the sky none.)
+        // weight × min(1, spread / kPointLikeSpread2), the first of equals.
+        // (By weight alone, a sun a few pixels wide would take a cut per
+        // halving of its rectangle, and the sky none.)
         std::size_t best = rects.size();
         for (std::size_t k = 0; k < rects.size(); ++k) {
             const Rect& r = rects[k];

@@ -2,11 +2,14 @@
 
 #include <hairvox/core/error.h>
 #include <hairvox/core/math.h>
+#include <hairvox/core/thread_scratch.h>
 
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <memory>
 
 namespace hairvox::detail {
@@ -76,7 +79,7 @@ RegionIrradiance::Value RegionIrradiance::at(std::size_t region, const Vec3f& n)
 
 EnvironmentLighting environmentLighting(const EnvironmentMap& map, const std::string& name,
                                         std::size_t count, EnvironmentSplit by,
-                                        std::size_t subdivisions) {
+                                        std::size_t subdivisions, std::size_t shadowRays) {
     EnvironmentLighting out;
     out.regions = map.split(count, by);
     for (std::size_t k = 0; k < out.regions.size(); ++k) {
@@ -87,9 +90,100 @@ EnvironmentLighting environmentLighting(const EnvironmentMap& map, const std::st
         light.intensity = 1.0f;
         out.lights.push_back(light);
         out.spread2.push_back(r.spread2);
+        out.shadowDirections.push_back(
+            map.split(std::max<std::size_t>(shadowRays, 1), EnvironmentSplit::Energy, r));
     }
     out.surfaces = RegionIrradiance(map, out.regions, subdivisions);
     return out;
+}
+
+RegionSurfaceShadow::RegionSurfaceShadow(std::shared_ptr<const LightGlobalTerm> inner,
+                                         std::shared_ptr<const SurfaceScene> surfaces,
+                                         std::span<const EnvironmentRegion> directions)
+    : inner_(std::move(inner))
+    , surfaces_(surfaces && !surfaces->empty() ? std::move(surfaces) : nullptr) {
+    double total = 0;
+    for (const EnvironmentRegion& d : directions)
+        total += double(d.irradiance.luminance());
+    for (const EnvironmentRegion& d : directions) {
+        directions_.push_back(d.direction);
+        weights_.push_back(total > 0 ? float(double(d.irradiance.luminance()) / total)
+                                     : 1.0f / float(directions.size()));
+    }
+}
+
+GlobalTermStats RegionSurfaceShadow::evaluate(std::span<const GlobalTermQuery> queries,
+                                              std::span<GlobalTerm> out) const {
+    if (!surfaces_ || directions_.empty())
+        return inner_->evaluate(queries, out);
+    // One segment per query and direction, a direction's tested together;
+    // `lit` sums the weights of the directions no surface blocks, `seen`
+    // counts them (every element of these arrays is written before it is
+    // read).
+    struct Scratch {
+        std::vector<Vec3f> origins, dirs;
+        std::vector<float> tMax, lit;
+        std::vector<std::uint8_t> blocked;
+        std::vector<std::uint32_t> seen;
+        std::vector<GlobalTermQuery> open;
+        std::vector<std::size_t> openIndex;
+        std::vector<GlobalTerm> openOut;
+    };
+    ThreadScratch<Scratch> scratch;
+    auto& [origins, dirs, tMax, lit, blocked, seen, open, openIndex, openOut] = *scratch;
+    const std::size_t n = queries.size();
+    origins.resize(n);
+    dirs.resize(n);
+    blocked.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+        origins[i] = queries[i].position;
+    tMax.assign(n, std::numeric_limits<float>::infinity());
+    lit.assign(n, 0.0f);
+    seen.assign(n, 0);
+    for (std::size_t d = 0; d < directions_.size(); ++d) {
+        std::fill(dirs.begin(), dirs.end(), directions_[d]);
+        surfaces_->occluded(origins, dirs, tMax, blocked);
+        for (std::size_t i = 0; i < n; ++i)
+            if (!blocked[i]) {
+                lit[i] += weights_[d];
+                ++seen[i];
+            }
+    }
+    const auto all = static_cast<std::uint32_t>(directions_.size());
+    GlobalTermStats stats;
+    std::uint64_t none = 0;
+    if (std::all_of(seen.begin(), seen.end(), [&](std::uint32_t s) { return s == all; })) {
+        // The common batch: nothing blocked, nothing to take out or scale.
+        stats = inner_->evaluate(queries, out);
+    } else {
+        open.clear();
+        openIndex.clear();
+        for (std::size_t i = 0; i < n; ++i) {
+            if (seen[i] > 0) {
+                open.push_back(queries[i]);
+                openIndex.push_back(i);
+            } else {
+                out[i] = GlobalTerm::blocked();
+                ++none;
+            }
+        }
+        openOut.resize(open.size());
+        stats = inner_->evaluate(open, openOut);
+        for (std::size_t k = 0; k < open.size(); ++k) {
+            const std::size_t i = openIndex[k];
+            GlobalTerm g = openOut[k];
+            if (seen[i] < all) { // a mixture with GlobalTerm::blocked(): V, P, T_s scale
+                const float f = std::min(lit[i], 1.0f);
+                g.V *= f;
+                g.P *= f;
+                g.T_s *= f;
+            }
+            out[i] = g;
+        }
+    }
+    stats.queries = n;
+    stats.blockedBySurface += none;
+    return stats;
 }
 
 BackgroundLayer backgroundLayer(const EnvironmentMap& map, const Camera& camera) {

@@ -8,7 +8,9 @@
 // that direction) and shaded with the fiber's longitudinal lobes widened by
 // the region's angular spread (DualScatteringShader::shade's spread2), so
 // that a region's R highlight is as wide as the region rather than a copy of
-// the lobe per light.
+// the lobe per light. The surfaces' shadow on the hair is the share of the
+// region's light they leave, from EnvironmentOptions::hairShadowRays rays per
+// point along the region cut again by energy (RegionSurfaceShadow).
 //
 // Surfaces (Lambertian). A region's light reaches a surface point with normal
 // n as E_k(n) = ∫_region L(ω) max(0, n·ω) dω — part of a region may lie below
@@ -27,10 +29,12 @@
 #include <hairvox/geometry/camera.h>
 #include <hairvox/geometry/environment_map.h>
 #include <hairvox/geometry/light.h>
+#include <hairvox/geometry/surface_scene.h>
 #include <hairvox/render/rasterizer.h>
 #include <hairvox/transmittance/global_term_model.h>
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <span>
 #include <string>
@@ -76,29 +80,45 @@ struct EnvironmentLighting {
     std::vector<Light> lights;
     std::vector<float> spread2;
     RegionIrradiance surfaces;
+    /// Per region: its sub-regions by energy, the directions the hair's
+    /// surface shadow is cast along (RegionSurfaceShadow).
+    std::vector<std::vector<EnvironmentRegion>> shadowDirections;
 };
 
 /// Cuts the map into `count` regions weighed `by`, tabulates what surfaces
-/// see of each (`subdivisions` sub-regions a region).
+/// see of each (`subdivisions` sub-regions a region), and cuts each into
+/// `shadowRays` directions for the hair's surface shadow.
 EnvironmentLighting environmentLighting(const EnvironmentMap& map, const std::string& name,
                                         std::size_t count, EnvironmentSplit by,
-                                        std::size_t subdivisions);
+                                        std::size_t subdivisions, std::size_t shadowRays);
 
-/// A global term shared by several holders (a region's, which the surfaces
-/// read as it is and the hair through withSurfaces()).
-class SharedGlobalTerm final : public LightGlobalTerm {
+/// What the hair sees of a region through the surfaces: the share of its
+/// light that no surface blocks, from one ray along each of `directions` (the
+/// region cut again by energy, EnvironmentLighting::shadowDirections), each
+/// weighing its share of the region's luminance. A region of the sky half
+/// behind a body lights hair lying on the body by half, where one ray along
+/// its mean direction gives all or nothing (Ratboy's mohawk on its body under
+/// sky.exr, 8 regions: 4 rays took the error against the path tracer from
+/// 0.431 to 0.404, at 1.5x the CPU time; docs/environment.md). The result is the
+/// mixture of `inner`'s term (the share) and GlobalTerm::blocked() (the
+/// rest): V, P and T_s scaled by the share, σ_f² (conditioned on a
+/// crossing) kept; a point no ray leaves is blocked without being evaluated.
+/// Without surfaces it is `inner`.
+class RegionSurfaceShadow final : public LightGlobalTerm {
 public:
-    explicit SharedGlobalTerm(std::shared_ptr<const LightGlobalTerm> inner)
-        : inner_(std::move(inner)) {}
+    RegionSurfaceShadow(std::shared_ptr<const LightGlobalTerm> inner,
+                        std::shared_ptr<const SurfaceScene> surfaces,
+                        std::span<const EnvironmentRegion> directions);
     GlobalTermStats evaluate(std::span<const GlobalTermQuery> queries,
-                             std::span<GlobalTerm> out) const override {
-        return inner_->evaluate(queries, out);
-    }
+                             std::span<GlobalTerm> out) const override;
     bool blocksEverything() const override { return inner_->blocksEverything(); }
     std::size_t memoryBytes() const override { return inner_->memoryBytes(); }
 
 private:
     std::shared_ptr<const LightGlobalTerm> inner_;
+    std::shared_ptr<const SurfaceScene> surfaces_; ///< null: none
+    std::vector<Vec3f> directions_;
+    std::vector<float> weights_; ///< each direction's share of the region's luminance
 };
 
 /// The map's backdrop as the camera sees it: per pixel the mean of

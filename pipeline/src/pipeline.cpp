@@ -115,10 +115,14 @@ void EnvironmentOptions::validate() const {
     if (surfaceSubdivisions < 1 || surfaceSubdivisions > 4096)
         throw InputError(strCat("environment surface subdivisions = ", surfaceSubdivisions,
                                 ": expected an integer in [1, 4096]"));
+    if (hairShadowRays < 1 || hairShadowRays > 64)
+        throw InputError(strCat("environment hair shadow rays = ", hairShadowRays,
+                                ": expected an integer in [1, 64]"));
 }
 
 void EnvironmentOptions::hashInto(Hasher& hasher) const {
     hasher.value(split).value(cacheSpacing).value(fiberSampleSpacing).value(surfaceSubdivisions);
+    hasher.value(hairShadowRays);
     hasher.value(spread);
 }
 
@@ -562,7 +566,8 @@ SceneRender renderRasterized(const Scene& scene, const PipelineOptions& options,
         const auto start = Clock::now();
         environment = detail::environmentLighting(
             *assets->environment, scene.environment->name, scene.environmentLights,
-            options.environment.split, options.environment.surfaceSubdivisions);
+            options.environment.split, options.environment.surfaceSubdivisions,
+            options.environment.hairShadowRays);
         EnvironmentReport& report = result.environment.emplace();
         report.splitSeconds = secondsSince(start);
         report.lights = environment->lights.size();
@@ -701,11 +706,12 @@ SceneRender renderRasterized(const Scene& scene, const PipelineOptions& options,
         background = detail::backgroundLayer(*assets->environment, camera);
     const double surfaceSeconds = secondsSince(surfacesStart);
 
-    // The hair's view of a region: shadowed by the surfaces along its
-    // direction, sampled along the fibers (grid and approx modes) every
+    // The hair's view of a region: the share of it the surfaces leave
+    // (EnvironmentOptions::hairShadowRays rays along the region cut again by
+    // energy), sampled along the fibers (grid and approx modes) every
     // EnvironmentOptions::fiberSampleSpacing voxels — the surfaces' shadow
     // too, which a directional light's keeps exact per point: a region of
-    // the sky casts a soft one, and a ray per fragment and region was a
+    // the sky casts a soft one, and rays per fragment and region were a
     // third of an environment-lit render's lookups.
     detail::ShadedEnvironment shadedEnvironment;
     if (environment) {
@@ -713,10 +719,10 @@ SceneRender renderRasterized(const Scene& scene, const PipelineOptions& options,
         shadedEnvironment.spread2 = environment->spread2;
         for (std::size_t l = 0; l < environmentCount; ++l)
             shadedEnvironment.terms.push_back(
-                environmentTerms[l]
-                    ? withSurfaces(std::make_unique<detail::SharedGlobalTerm>(environmentTerms[l]),
-                                   assets->surfaces.scene, environment->lights[l])
-                    : nullptr);
+                environmentTerms[l] ? std::make_shared<detail::RegionSurfaceShadow>(
+                                          environmentTerms[l], assets->surfaces.scene,
+                                          environment->shadowDirections[l])
+                                    : nullptr);
         if (assets->grid) {
             shadedEnvironment.groom = &assets->groom.groom;
             shadedEnvironment.spacing = options.environment.fiberSampleSpacing *

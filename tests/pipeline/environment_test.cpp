@@ -3,14 +3,17 @@
 // identities in the dual-scattering integrator (a uniform environment on a
 // Lambertian sphere gives ρ·L, a patch at the zenith is a directional light
 // from +y of the same irradiance); what surfaces see of the regions sums to
-// the map's irradiance; the backdrop; determinism and frame reuse.
+// the map's irradiance; the surfaces' shadow on the hair from several rays a
+// region; the options' ranges; the backdrop; determinism and frame reuse.
 #include "../../pipeline/src/environment_lights.h"
+#include "../transmittance/slab.h"
 #include "film/film_bytes.h"
 #include "test_util.h"
 
 #include <hairvox/core/error.h>
 #include <hairvox/core/math.h>
 #include <hairvox/pipeline/pipeline.h>
+#include <hairvox/transmittance/exact_global_term.h>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -218,7 +221,7 @@ TEST(PipelineEnvironment, TheRegionsOverTheNormalsSumToTheMapsIrradiance) {
         const EnvironmentMap map =
             EnvironmentMap::readExr(test::dataDir() / "hdri" / name, Rgb(1.0f), 30.0f, 1u << 30);
         const detail::EnvironmentLighting lighting =
-            detail::environmentLighting(map, "env", 16, EnvironmentSplit::Energy, 16);
+            detail::environmentLighting(map, "env", 16, EnvironmentSplit::Energy, 16, 4);
         ASSERT_EQ(lighting.lights.size(), 16u);
         for (const Vec3f& n : {Vec3f(0, 1, 0), Vec3f(0, -1, 0), Vec3f(1, 0, 0),
                                glm::normalize(Vec3f(0.3f, 0.4f, -0.8f)),
@@ -229,6 +232,79 @@ TEST(PipelineEnvironment, TheRegionsOverTheNormalsSumToTheMapsIrradiance) {
             const Rgb exact = map.irradiance(n);
             for (int c = 0; c < 3; ++c)
                 EXPECT_NEAR(sum[c], exact[c], 0.02f * exact[c] + 1e-3f) << name << " " << n;
+        }
+    }
+}
+
+TEST(PipelineEnvironment, TheHairsSurfaceShadowIsTheShareOfTheRegionNoSurfaceBlocks) {
+    // A point inside the slab of hair (its real exact global term toward +y)
+    // and a region cut into two directions: +y with 3/4 of its luminance, +x
+    // with 1/4. The surfaces block neither, the +x one, or both.
+    const test::Slab slab;
+    const Groom groom = slab.groom();
+    const auto model =
+        makeExactModel(groom, {test::constantTable(0.5f, 0.01f)}, test::slabSettings(), {});
+    const std::shared_ptr<const LightGlobalTerm> inner =
+        model->forLight(Light::directional(Vec3f(0, 1, 0)));
+    std::vector<EnvironmentRegion> directions(2);
+    directions[0].direction = Vec3f(0, 1, 0);
+    directions[0].irradiance = Rgb(3.0f);
+    directions[1].direction = Vec3f(1, 0, 0);
+    directions[1].irradiance = Rgb(1.0f);
+    const GlobalTermQuery q{Vec3f(0, 0.001f, 0), Vec3f(1, 0, 0)};
+    GlobalTerm unshadowed;
+    inner->evaluate({&q, 1}, {&unshadowed, 1});
+    ASSERT_LT(unshadowed.V, 0.9f);
+    ASSERT_GT(unshadowed.T_s.g, 0.0f);
+
+    const Sphere far{Vec3f(0, -1, 0), 0.1f}, right{Vec3f(0.3f, 0.001f, 0), 0.05f},
+        above{Vec3f(0, 0.5f, 0), 0.1f};
+    const auto shadowed = [&](std::vector<Sphere> spheres, GlobalTermStats* stats = nullptr) {
+        const detail::RegionSurfaceShadow term(
+            inner, std::make_shared<SurfaceScene>(std::move(spheres), std::vector<TriangleMesh>{}),
+            directions);
+        GlobalTerm g;
+        const GlobalTermStats s = term.evaluate({&q, 1}, {&g, 1});
+        if (stats)
+            *stats = s;
+        return g;
+    };
+
+    const GlobalTerm open = shadowed({far});
+    EXPECT_EQ(open.V, unshadowed.V);
+    EXPECT_EQ(open.P, unshadowed.P);
+    EXPECT_EQ(open.T_s, unshadowed.T_s);
+
+    const GlobalTerm quarter = shadowed({far, right});
+    EXPECT_NEAR(quarter.V, 0.75f * unshadowed.V, 1e-6f);
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(quarter.P[c], 0.75f * unshadowed.P[c], 1e-6f);
+        EXPECT_NEAR(quarter.T_s[c], 0.75f * unshadowed.T_s[c], 1e-6f);
+        EXPECT_EQ(quarter.sigma2_f[c], unshadowed.sigma2_f[c]);
+    }
+
+    GlobalTermStats stats;
+    const GlobalTerm none = shadowed({right, above}, &stats);
+    EXPECT_EQ(none.V, 0.0f);
+    EXPECT_EQ(none.P, Rgb(0.0f));
+    EXPECT_EQ(none.T_s, Rgb(0.0f));
+    EXPECT_EQ(stats.queries, 1u);
+    EXPECT_EQ(stats.blockedBySurface, 1u);
+    EXPECT_EQ(stats.evaluated, 0u);
+}
+
+TEST(PipelineEnvironment, OptionsOutOfRangeNameTheOptionAndTheRange) {
+    EnvironmentOptions ok;
+    EXPECT_NO_THROW(ok.validate());
+    for (const std::size_t rays : {std::size_t(0), std::size_t(65)}) {
+        EnvironmentOptions o;
+        o.hairShadowRays = rays;
+        try {
+            o.validate();
+            ADD_FAILURE() << rays << " rays accepted";
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find("hair shadow rays"), std::string::npos);
+            EXPECT_NE(std::string(e.what()).find("[1, 64]"), std::string::npos);
         }
     }
 }

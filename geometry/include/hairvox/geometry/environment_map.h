@@ -40,14 +40,17 @@
 // the number asked for. Weight is luminance × solid angle (energy: bright
 // areas get many small regions), or solid angle alone (equal areas: the
 // baseline of K uniform directions). Debevec cuts every rectangle each round;
-// here the rectangle cut next is the one whose weight × spread about its mean
-// direction (its second moment: what a point light standing for it gets
-// wrong) is largest — so a sun a few pixels wide is cut down to a few
-// degrees and the rest of the cuts go to the sky, where cutting by weight
-// alone spends one per halving of the sun's rectangle (fifteen for sky.exr)
-// and leaves the sky one or two. A region stands for a directional light of
-// irradiance ∫_region L dω from its energy-weighted mean direction, with the
-// angular spread of its energy about that direction.
+// here the rectangle cut next is the one of the largest weight ×
+// min(1, spread / kPointLikeSpread2): its weight while it is wider than the
+// narrowest lobe it lights (hair's R, 5–10°), then its second moment about
+// its mean direction in units of that lobe — so a sun a few pixels wide is
+// cut down to a few degrees and the rest of the cuts go to the sky, where
+// cutting by weight alone spends one per halving of the sun's rectangle and
+// leaves the sky one or two, and a bright softbox is cut until its pieces are
+// about as narrow as the R lobe, where the second moment alone could leave it
+// one wide region (docs/environment.md). A region stands for a directional
+// light of irradiance ∫_region L dω from its energy-weighted mean direction,
+// with the angular spread of its energy about that direction.
 #pragma once
 
 #include <hairvox/core/distribution.h>
@@ -111,6 +114,9 @@ public:
         double energy = 0;        ///< what they carried, a share of the map's energy after
     };
     static constexpr int kFoldRadius = 8;
+    /// A region's spread (EnvironmentRegion::spread2, rad²) below which it
+    /// lights like a point: (0.1 rad)², about hair's R lobe (β_R 5–10°).
+    static constexpr float kPointLikeSpread2 = 0.01f;
 
     /// What a map costs a pixel: its RGB (12 bytes), the sampling
     /// distribution's value and cumulative sum (12), and while it is read the
