@@ -252,7 +252,7 @@ def malformed():
         "non-finite coordinate")
     bad("environment_missing_file.json",
         scene_with(lights=[{"type": "environment", "file": "no_such_map.exr"}]),
-        "environment light \"environment\": no_such_map.exr: cannot read OpenEXR file")
+        "no_such_map.exr: cannot read OpenEXR file")
     bad("environment_not_an_exr.json",
         scene_with(lights=[{"type": "environment", "file": "empty.obj"}]),
         "empty.obj: cannot read OpenEXR file")

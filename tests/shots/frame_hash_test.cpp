@@ -87,8 +87,8 @@ TEST(ShotsFrameHash, FilesCountByContentNotByNameOrPlace) {
 // of them changes size (x86-64, GCC): add the field to hashSceneInto
 // (shots/src/frame_hash.cpp), then the new size here.
 TEST(ShotsFrameHash, CoversEveryFieldOfTheScene) {
-    EXPECT_EQ(sizeof(Scene), 608u);
-    EXPECT_EQ(sizeof(GroomSource), 144u);
+    EXPECT_EQ(sizeof(Scene), 784u);
+    EXPECT_EQ(sizeof(GroomSource), 160u);
     EXPECT_EQ(sizeof(ProceduralGroomParams), 96u);
     EXPECT_EQ(sizeof(CameraParams), 48u);
     EXPECT_EQ(sizeof(Head), 28u);
@@ -97,6 +97,8 @@ TEST(ShotsFrameHash, CoversEveryFieldOfTheScene) {
     EXPECT_EQ(sizeof(ExactSettings), 16u);
     EXPECT_EQ(sizeof(PathTraceSettings), 40u);
     EXPECT_EQ(sizeof(OutputSettings), 128u);
+    EXPECT_EQ(sizeof(EnvironmentLight), 96u);
+    EXPECT_EQ(sizeof(VolumetricSettings), 56u); // (VolumetricSettings::hashInto)
 }
 
 } // namespace
