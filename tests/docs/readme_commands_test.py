@@ -8,9 +8,9 @@ checkout's, `hairvox` on PATH is this build's executable (HAIRVOX_BINARY), and
 time limit.
 
 Not run (SKIPPED, each with its reason): the two setup commands (they install
-packages and build), the benchmark (minutes), the full 240-frame shot (the
-24th-frame preview before it runs the same code) and the Slurm submission (no
-cluster here; tests/shots/slurm_test.cpp runs a real one). Made cheaper
+packages and build), the benchmark (minutes), the full 240-frame shot and its sheet (the
+preview of every 48th frame and its sheet run the same code) and the Slurm
+submission (no cluster here; tests/shots/slurm_test.cpp runs a real one). Made cheaper
 (CHEAPER): the path-traced reference runs at 4 samples instead of 256, so the
 `compare` after it has its input. A skip or substitution that no longer
 matches a README command fails the test, so the lists cannot go stale.
@@ -39,7 +39,9 @@ SKIPPED = [
     (r"bash scripts/test\.sh\b.*", "setup: installs packages, builds and runs every test"),
     (r"hairvox bench\b.*", "the benchmark takes minutes"),
     (r"hairvox render data/shots/turntable\.json --frames 1-240\s*(#.*)?",
-     "240 frames at 1024²; the preview of every 24th frame runs the same code"),
+     "240 frames at 1024²; the preview of every 48th frame runs the same code"),
+    (r"hairvox sheet data/shots/turntable\.json\s*(#.*)?",
+     "needs all 240 frames; the preview's sheet runs the same code"),
     (r"hairvox submit\b.*", "needs a Slurm cluster (tests/shots/slurm_test.cpp runs one)"),
 ]
 
