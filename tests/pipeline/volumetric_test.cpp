@@ -134,6 +134,28 @@ TEST(Volumetric, DarkHairScattersLessThanLightHair) {
     EXPECT_LT(dark, 0.2 * light) << "light " << light << ", dark " << dark;
 }
 
+TEST(Volumetric, AnEnvironmentLightsTheSolveThroughItsRegions) {
+    test::TempDir dir;
+    Scene scene = smallVolumetric();
+    scene.volumetric.paths = 20000;
+    scene.lights.clear();
+    scene.environment = EnvironmentLight{}; // uniform white
+    scene.environment->visible = false;
+    const SceneRender r = render(scene, dir);
+    ASSERT_TRUE(r.volumetric.has_value());
+    // Every region lights the solve: the paths are shared among them.
+    EXPECT_EQ(r.volumetric->pathsPerLight.size(), std::size_t(scene.environmentLights));
+    for (const std::uint64_t n : r.volumetric->pathsPerLight)
+        EXPECT_GT(n, 0u);
+    double direct = 0;
+    for (const char* name : {"direct_R", "direct_TT", "direct_TRT"})
+        direct += layerSum(r.film, name);
+    const double multiple = layerSum(r.film, "multiple");
+    EXPECT_GT(direct, 0.0);
+    EXPECT_GT(multiple, 0.2 * direct); // light hair under light from everywhere
+    EXPECT_TRUE(std::isfinite(multiple));
+}
+
 TEST(Volumetric, SameBytesForAnyThreadCount) {
     test::TempDir dir;
     Scene scene = smallVolumetric(800, 48);
