@@ -14,7 +14,6 @@
 #include <hairvox/strands/groom_io.h>
 #include <hairvox/transmittance/exact_global_term.h>
 
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
