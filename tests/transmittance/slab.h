@@ -7,6 +7,7 @@
 #include <hairvox/strands/groom.h>
 #include <hairvox/transmittance/crossing_table.h>
 #include <hairvox/transmittance/global_term_model.h>
+#include <hairvox/voxelize/fiber_grid.h>
 
 #include <cmath>
 
@@ -43,6 +44,14 @@ struct Slab {
 
 /// The fiber diameter of the slab tests: with the default slab, n = 2 straight up.
 constexpr float kSlabDiameter = 5e-5f;
+
+/// The slab's fiber grid at `voxelSize` (diameter kSlabDiameter).
+inline FiberGrid splatSlab(const Slab& slab, double voxelSize) {
+    SplatOptions options;
+    options.voxelSize = voxelSize;
+    options.fiberScale.diameter = kSlabDiameter;
+    return splatStrands(slab.groom(), options);
+}
 
 /// Global-term settings of the slab tests (diameter kSlabDiameter, defaults otherwise).
 inline GlobalTermSettings slabSettings() {

@@ -12,13 +12,6 @@
 namespace hairvox {
 namespace {
 
-FiberGrid splatSlab(const test::Slab& slab, double voxelSize) {
-    SplatOptions options;
-    options.voxelSize = voxelSize;
-    options.fiberScale.diameter = test::kSlabDiameter;
-    return splatStrands(slab.groom(), options);
-}
-
 /// Random unit-length segments of uniformly random direction in a 4 cm box:
 /// fibers with no preferred orientation (coherence near 0).
 Groom isotropicSegments(int count, std::uint64_t seed) {
@@ -36,7 +29,7 @@ Groom isotropicSegments(int count, std::uint64_t seed) {
 
 TEST(FiberMedium, ExtinctionOfASlabIsItsClosedForm) {
     const test::Slab slab;
-    const FiberGrid grid = splatSlab(slab, 0.002);
+    const FiberGrid grid = test::splatSlab(slab, 0.002);
     const FiberMedium medium(grid);
     // Inside the slab, away from its faces, over many points: λ·D·|ω × x̂|.
     for (const Vec3f omega : {Vec3f(0, 1, 0), glm::normalize(Vec3f(1, 1, 0)), Vec3f(0, 0, 1)}) {
@@ -58,7 +51,7 @@ TEST(FiberMedium, ExtinctionOfASlabIsItsClosedForm) {
 
 TEST(FiberMedium, FreeFlightsThroughASlabFollowBeerLambert) {
     const test::Slab slab;
-    const FiberGrid grid = splatSlab(slab, 0.002);
+    const FiberGrid grid = test::splatSlab(slab, 0.002);
     const FiberMedium medium(grid);
     for (const Vec3f omega : {Vec3f(0, 1, 0), glm::normalize(Vec3f(0, 1, 0.6f)),
                               glm::normalize(Vec3f(0.8f, 1, 0))}) {
@@ -92,7 +85,7 @@ TEST(FiberMedium, FreeFlightsThroughASlabFollowBeerLambert) {
 
 TEST(FiberMedium, CollisionsMeetTheSlabsFibersAlongTheirDirection) {
     const test::Slab slab;
-    const FiberGrid grid = splatSlab(slab, 0.002);
+    const FiberGrid grid = test::splatSlab(slab, 0.002);
     const FiberMedium medium(grid);
     Pcg32 rng(5);
     int collisions = 0;
@@ -135,7 +128,7 @@ TEST(FiberMedium, IsotropicFibersAreMetInProportionToTheirCrossSection) {
 TEST(FiberMedium, WalkingVoxelsIntegratesTheDensityAlongALine) {
     const test::Slab slab;
     const double h = 0.002;
-    const FiberGrid grid = splatSlab(slab, h);
+    const FiberGrid grid = test::splatSlab(slab, h);
     const FiberMedium medium(grid);
     Pcg32 rng(2);
     for (int line = 0; line < 20; ++line) {

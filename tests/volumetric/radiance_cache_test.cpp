@@ -15,17 +15,10 @@
 namespace hairvox {
 namespace {
 
-FiberGrid splatSlab(const test::Slab& slab, double voxelSize) {
-    SplatOptions options;
-    options.voxelSize = voxelSize;
-    options.fiberScale.diameter = test::kSlabDiameter;
-    return splatStrands(slab.groom(), options);
-}
-
 TEST(RadianceCache, CellsHoldTheFibersLengthAlongTheirAxis) {
     test::Slab slab;
     slab.fibers = 2000;
-    const FiberGrid grid = splatSlab(slab, 0.002);
+    const FiberGrid grid = test::splatSlab(slab, 0.002);
     RadianceCacheSettings settings;
     settings.cellVoxels = 2;
     const RadianceCache cache(grid, settings, 1ull << 30);
@@ -45,7 +38,7 @@ TEST(RadianceCache, CellsHoldTheFibersLengthAlongTheirAxis) {
 TEST(RadianceCache, DepositsProjectTheIncidentField) {
     test::Slab slab;
     slab.fibers = 2000;
-    const FiberGrid grid = splatSlab(slab, 0.002);
+    const FiberGrid grid = test::splatSlab(slab, 0.002);
     RadianceCacheSettings settings;
     settings.basis.thetaBins = 8;
     settings.basis.azimuthalOrder = 2;
@@ -78,7 +71,7 @@ TEST(RadianceCache, DepositsProjectTheIncidentField) {
 TEST(RadianceCache, UniformIncidentLightLeavesAsTheFibersAlbedo) {
     test::Slab slab;
     slab.fibers = 2000;
-    const FiberGrid grid = splatSlab(slab, 0.002);
+    const FiberGrid grid = test::splatSlab(slab, 0.002);
     RadianceCacheSettings settings;
     RadianceCache cache(grid, settings, 1ull << 30);
     // Every cell lit by uniform radiance 1 from every direction: a regular
@@ -123,7 +116,7 @@ TEST(RadianceCache, UniformIncidentLightLeavesAsTheFibersAlbedo) {
 
 TEST(RadianceCache, RefusesACacheOverItsBudget) {
     test::Slab slab;
-    const FiberGrid grid = splatSlab(slab, 0.001);
+    const FiberGrid grid = test::splatSlab(slab, 0.001);
     RadianceCacheSettings settings;
     settings.cellVoxels = 1;
     try {
