@@ -21,7 +21,13 @@ PiecewiseConstant1D::PiecewiseConstant1D(std::span<const float> f)
     integral_ = cdf_[n];
     for (std::size_t i = 1; i <= n; ++i)
         cdf_[i] = integral_ > 0 ? cdf_[i] / integral_ : double(i) / double(n);
-    cdf_[n] = 1.0;
+    // 1 from the end of the last interval of any weight on: the sum rounds
+    // to just below 1 as often as to 1, and a u above it would otherwise land
+    // in a trailing interval of weight 0 (a sample of density 0).
+    std::size_t last = n;
+    while (integral_ > 0 && last > 0 && func_[last - 1] == 0)
+        --last;
+    std::fill(cdf_.begin() + std::ptrdiff_t(last), cdf_.end(), 1.0);
 }
 
 PiecewiseConstant1D::Sample PiecewiseConstant1D::sample(float u) const {
@@ -34,7 +40,9 @@ PiecewiseConstant1D::Sample PiecewiseConstant1D::sample(float u) const {
     const double n = double(func_.size());
     Sample s;
     s.index = i;
-    s.x = std::min(float((double(i) + du) / n), std::nextafter(1.0f, 0.0f));
+    // In its own interval: (i + du)/n can round up to the next one's start.
+    s.x = std::min(float((double(i) + du) / n),
+                   std::nextafter(float((double(i) + 1.0) / n), 0.0f));
     s.pdf = pdf(i);
     return s;
 }

@@ -242,8 +242,18 @@ Rgb EnvironmentMap::backdrop(const Vec3f& omega) const {
 
 EnvironmentSample EnvironmentMap::sample(float u0, float u1) const {
     const PiecewiseConstant2D::Sample s = distribution_.sample(u0, u1);
+    // The point kept a thousandth of a cell inside the cell the uniforms
+    // chose: the round trip through direction() and coordinates() (two
+    // rotations, trigonometry) must find that cell again, and at a cell's
+    // edge rounding can step into a neighbour of another density — one of
+    // none gave a sample of pdf 0 under another compiler's contractions.
+    static constexpr float kInside = 1e-3f;
+    const auto inside = [](float x, std::size_t cell, int cells) {
+        const float f = std::clamp(x * float(cells) - float(cell), kInside, 1.0f - kInside);
+        return (float(cell) + f) / float(cells);
+    };
     EnvironmentSample out;
-    out.omega = direction(s.u, s.v);
+    out.omega = direction(inside(s.u, s.column, width_), inside(s.v, s.row, height_));
     // The radiance and density of the direction as made (not of the cell the
     // uniforms chose): the same numbers pdf() and radiance() give for it.
     out.pdf = pdf(out.omega);
@@ -253,7 +263,11 @@ EnvironmentSample EnvironmentMap::sample(float u0, float u1) const {
 }
 
 float EnvironmentMap::pdf(const Vec3f& omega) const {
-    const float sinTheta = cosFromSin(std::clamp(omega.y, -1.0f, 1.0f));
+    // sin θ from the components across +y: within a few cells of a pole
+    // cos θ rounds to ±1 in float, while x and z keep the direction's distance
+    // from it (a sample drawn there had a density of 0 read back).
+    const float sinTheta =
+        std::min(1.0f, std::sqrt(omega.x * omega.x + omega.z * omega.z));
     if (!(sinTheta > 0))
         return 0;
     const Vec2f uv = coordinates(omega);

@@ -76,7 +76,7 @@ TEST(PathTracerEnvironment, OneFiberSingleScatteringIsTheQuadratureOfTheMap) {
     scene.camera.width = scene.camera.height = size;
     scene.environment = map;
     PathTraceSettings settings;
-    settings.spp = 2048;
+    settings.spp = 16384;
     settings.maxDepth = 1; // camera → fiber → environment
     const Film film = pathTrace(scene, settings).film;
 
@@ -120,11 +120,13 @@ TEST(PathTracerEnvironment, OneFiberSingleScatteringIsTheQuadratureOfTheMap) {
         got[2] += double(film.layer("direct_TRT").rgb(i).g);
     }
     ASSERT_GT(double(expected.R.g), 0.0);
-    // Measured over seeds 1-4 at this sample count: R and TT within 1.6%,
-    // TRT (1.5% of the light, drawn mostly by the others' samples) within 9%.
+    // Measured over seeds 1-6 at this sample count (GCC): R within 1.0%, TT
+    // 0.3%, TRT (1.5% of the light, drawn mostly by the others' samples)
+    // 2.4%; Clang's rounding draws other samples (seeds 1 and 5: TRT +0.9%,
+    // −2.1%). At 2048 samples TRT spread over −16%…+20%.
     EXPECT_NEAR(got[0], double(expected.R.g), 0.03 * double(expected.R.g));
     EXPECT_NEAR(got[1], double(expected.TT.g), 0.03 * double(expected.TT.g));
-    EXPECT_NEAR(got[2], double(expected.TRT.g), 0.12 * double(expected.TRT.g));
+    EXPECT_NEAR(got[2], double(expected.TRT.g), 0.08 * double(expected.TRT.g));
 }
 
 /// The mean of the surface layer over the pixels the surfaces cover wholly.
