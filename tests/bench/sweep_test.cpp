@@ -234,7 +234,8 @@ TEST(BenchSweep, TinySweepWritesTablesAndPlots) {
           "## Scaling with image size", "cost ∝ pixels^k: total time k = ",
           "## Scaling with active voxels", "| tiny 24 mm | 0.024 |",
           "cost ∝ active voxels^k: total time k = ",
-          "## Model error: dual scattering against path tracing", "| tiny, dark | grid | ",
+          "## Model error: dual scattering and volumetric against path tracing",
+          "| tiny, dark | grid | ",
           "| tiny, dark | volumetric | "})
         EXPECT_NE(text.find(needle), std::string::npos) << needle << "\n" << text;
 

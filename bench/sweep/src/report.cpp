@@ -93,16 +93,16 @@ std::string modelMarkdown(const SweepOptions& o, const std::vector<BenchRow>& ro
     const std::vector<std::string> scenes = sceneOrder(rows, BenchSweepKind::PathReference);
     if (scenes.empty())
         return {};
-    std::string md = "## Model error: dual scattering against path tracing\n\n";
+    std::string md = "## Model error: dual scattering and volumetric against path tracing\n\n";
     md += strCat(
         "The hair's radiance (the beauty without head and background) of each global-term mode "
-        "against a path trace of the same fibers with the same f_s (docs/DESIGN.md §8), "
+        "and of the volumetric integrator (docs/DESIGN.md §9) against a path trace of the same fibers with the same f_s (docs/DESIGN.md §8), "
         "compared as means over ",
         o.model.block, "×", o.model.block,
         " pixel blocks. `floor`: the relative L1 the reference's own noise gives (from its "
         "two independent halves); `noise removed`: sqrt(L1² − floor²) — an error within 1.5× "
-        "its floor is not resolved (marked ~). `bias`: signed, dual scattering brighter when "
-        "positive. Target: grid within 0.05 with the noise removed.\n\n");
+        "its floor is not resolved (marked ~). `bias`: signed, the estimate brighter when "
+        "positive. Target: within 0.05 with the noise removed.\n\n");
     md += "| scene, hair | method | rel L1 | floor | noise removed | bias | s | reference s | "
           "spp | Mrays/s | Mpaths/s |\n";
     md += "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
