@@ -26,6 +26,7 @@
 // fiber grid and the lights' preparation with other processes (a farm's tasks).
 #include "../commands.h"
 
+#include <hairvox/core/atomic_file.h>
 #include <hairvox/core/error.h>
 #include <hairvox/core/progress.h>
 #include <hairvox/pipeline/pipeline.h>
@@ -68,16 +69,6 @@ struct RenderCommandOptions {
     bool force = false;   ///< a shot's frames that are done rendered again
     std::string cacheDir; ///< the shared disk cache (PipelineOptions::diskCache)
 };
-
-/// Two paths naming the same file (textually, or the same existing file).
-bool sameFile(const std::filesystem::path& a, const std::filesystem::path& b) {
-    std::error_code ec;
-    if (std::filesystem::absolute(a, ec).lexically_normal() ==
-        std::filesystem::absolute(b, ec).lexically_normal())
-        return true;
-    return std::filesystem::exists(a, ec) && std::filesystem::exists(b, ec) &&
-           std::filesystem::equivalent(a, b, ec);
-}
 
 std::string lowerExtension(const std::filesystem::path& p) {
     std::string ext = p.extension().string();

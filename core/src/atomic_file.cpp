@@ -87,4 +87,13 @@ void writeFileAtomically(const fs::path& finalPath,
     }
 }
 
+bool sameFile(const std::filesystem::path& a, const std::filesystem::path& b) {
+    std::error_code ec;
+    if (std::filesystem::absolute(a, ec).lexically_normal() ==
+        std::filesystem::absolute(b, ec).lexically_normal())
+        return true;
+    return std::filesystem::exists(a, ec) && std::filesystem::exists(b, ec) &&
+           std::filesystem::equivalent(a, b, ec);
+}
+
 } // namespace hairvox

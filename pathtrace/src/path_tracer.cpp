@@ -202,6 +202,16 @@ public:
                 const RayOrigin here{hit->fiber, slack_};
                 const MarschnerBcsdf& bcsdf = bcsdfs_[fiberTypeAt(
                     *scene_.groom, segmentStartPoint(hit->fiber.strand, hit->fiber.segment))];
+                // Light e scattered toward the camera by lobes f: by lobe at depth 1.
+                const auto addScattered = [&](const Rgb& e, const LobeValues& f) {
+                    if (events == 1) {
+                        out.add(kDirectR, e * f.R);
+                        out.add(kDirectTT, e * f.TT);
+                        out.add(kDirectTRT, e * f.TRT);
+                    } else {
+                        out.add(deeper, e * f.sum());
+                    }
+                };
                 for (const Light& light : lights_) {
                     const Light::Path path = light.pathFrom(xHit);
                     if (!(path.distance > 0))
@@ -212,15 +222,8 @@ public:
                     ++counters.shadowRays;
                     if (rays_.occluded(xHit, path.omega, path.distance, &here))
                         continue;
-                    const LobeValues f = bcsdf.eval(a);
-                    const Rgb e = throughput * light.irradiance(path.distance) * a.cosTheta_i;
-                    if (events == 1) {
-                        out.add(kDirectR, e * f.R);
-                        out.add(kDirectTT, e * f.TT);
-                        out.add(kDirectTRT, e * f.TRT);
-                    } else {
-                        out.add(deeper, e * f.sum());
-                    }
+                    addScattered(throughput * light.irradiance(path.distance) * a.cosTheta_i,
+                                 bcsdf.eval(a));
                 }
                 if (env_) {
                     // A direction from the map, weighted against f_s sampling's density.
@@ -232,16 +235,9 @@ public:
                         ++counters.environmentShadowRays;
                         if (!rays_.occluded(xHit, es.omega, std::numeric_limits<float>::infinity(),
                                             &here)) {
-                            const LobeValues f = bcsdf.eval(a);
                             const float w = powerHeuristic(es.pdf, bcsdf.pdf(a)) / es.pdf;
-                            const Rgb e = throughput * es.radiance * (a.cosTheta_i * w);
-                            if (events == 1) {
-                                out.add(kDirectR, e * f.R);
-                                out.add(kDirectTT, e * f.TT);
-                                out.add(kDirectTRT, e * f.TRT);
-                            } else {
-                                out.add(deeper, e * f.sum());
-                            }
+                            addScattered(throughput * es.radiance * (a.cosTheta_i * w),
+                                         bcsdf.eval(a));
                         }
                     }
                 }

@@ -21,6 +21,7 @@
 #include <exception>
 #include <iomanip>
 #include <map>
+#include <span>
 #include <sstream>
 #include <unistd.h>
 
@@ -667,7 +668,8 @@ SceneRender renderRasterized(const Scene& scene, const PipelineOptions& options,
         key.value(frame.modelKey);
         // The environment's regions light the solve as they light the
         // shader: directional lights of each region's irradiance.
-        const std::vector<Light> regions = environment ? environment->lights : std::vector<Light>{};
+        const std::span<const Light> regions =
+            environment ? std::span<const Light>(environment->lights) : std::span<const Light>{};
         for (const Light& light : scene.lights)
             key.value(detail::lightKey(frame.modelKey, light));
         for (const Light& light : regions)

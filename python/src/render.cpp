@@ -14,6 +14,7 @@
 #include "bindings.h"
 #include "long_call.h"
 
+#include <hairvox/core/atomic_file.h>
 #include <hairvox/core/error.h>
 #include <hairvox/pipeline/pipeline.h>
 
@@ -322,16 +323,6 @@ void applyOverrides(Scene& scene, py::handle width, py::handle height, py::handl
                                 " (keeping the scene camera's aspect ratio): expected at most ",
                                 kMaxSide, " pixels a side; give both width and height"));
     scene.validate();
-}
-
-/// Two paths naming the same file (textually, or the same existing file).
-bool sameFile(const std::filesystem::path& a, const std::filesystem::path& b) {
-    std::error_code ec;
-    if (std::filesystem::absolute(a, ec).lexically_normal() ==
-        std::filesystem::absolute(b, ec).lexically_normal())
-        return true;
-    return std::filesystem::exists(a, ec) && std::filesystem::exists(b, ec) &&
-           std::filesystem::equivalent(a, b, ec);
 }
 
 /// save()'s outputs, as the CLI resolves --exr, --png and -o

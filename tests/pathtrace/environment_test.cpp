@@ -5,6 +5,7 @@
 // and f_s sampling whose weights sum to one), a sun's noise against a nearly
 // uniform sky's, determinism.
 #include "film/film_bytes.h"
+#include "scene_test_util.h"
 #include "test_util.h"
 
 #include <hairvox/core/distribution.h>
@@ -129,17 +130,7 @@ TEST(PathTracerEnvironment, OneFiberSingleScatteringIsTheQuadratureOfTheMap) {
     EXPECT_NEAR(got[2], double(expected.TRT.g), 0.08 * double(expected.TRT.g));
 }
 
-/// The mean of the surface layer over the pixels the surfaces cover wholly.
-Rgb meanSurface(const Film& film) {
-    Rgbd sum(0.0);
-    double n = 0;
-    for (std::size_t p = 0; p < film.pixelCount(); ++p)
-        if (film.layer("A").scalar(p) > 0.999f) {
-            sum += Rgbd(film.layer("surface").rgb(p));
-            n += 1;
-        }
-    return Rgb(sum / n);
-}
+using test::meanSurface;
 
 TEST(PathTracerEnvironment, AUniformEnvironmentOnALambertianSphereIsAlbedoTimesRadiance) {
     const Groom none;

@@ -6,6 +6,7 @@
 // the map's irradiance; the surfaces' shadow on the hair from several rays a
 // region; the options' ranges; the backdrop; determinism and frame reuse.
 #include "../../pipeline/src/environment_lights.h"
+#include "scene_test_util.h"
 #include "../transmittance/slab.h"
 #include "film/film_bytes.h"
 #include "test_util.h"
@@ -36,12 +37,7 @@ nlohmann::json environmentScene() {
 }
 
 std::string errorOf(const nlohmann::json& j) {
-    try {
-        parseScene(j, "scene.json", "/scenes");
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "";
+    return test::sceneErrorOf(j);
 }
 
 TEST(SceneEnvironment, KeysParse) {
@@ -136,17 +132,7 @@ TEST(PipelineEnvironment, AMissingMapIsAnErrorNamingTheLightAndTheFile) {
     }
 }
 
-/// The mean of the surface layer over the pixels wholly covered (A = 1).
-Rgb meanSurface(const Film& film) {
-    Rgbd sum(0.0);
-    double n = 0;
-    for (std::size_t p = 0; p < film.pixelCount(); ++p)
-        if (film.layer("A").scalar(p) > 0.999f) {
-            sum += Rgbd(film.layer("surface").rgb(p));
-            n += 1;
-        }
-    return Rgb(sum / n);
-}
+using test::meanSurface;
 
 // A Lambertian sphere of albedo ρ under a uniform environment L, nothing in
 // front of it: ρ·L in both integrators (issue 37's identity, 2%).

@@ -1,4 +1,5 @@
 #include "test_util.h"
+#include "scene_test_util.h"
 
 #include <hairvox/core/error.h>
 #include <hairvox/pipeline/scene.h>
@@ -24,14 +25,8 @@ nlohmann::json validScene() {
     })");
 }
 
-/// The InputError message of parsing `j` as "scene.json", or "" if it parses.
 std::string errorOf(const nlohmann::json& j) {
-    try {
-        parseScene(j, "scene.json", "/scenes");
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "";
+    return test::sceneErrorOf(j);
 }
 
 TEST(Scene, ValidSceneGetsDefaults) {

@@ -2,6 +2,7 @@
 // scene keys, its layers, its determinism, and its multiple scattering
 // against the path tracer's on block means of the hair's radiance.
 #include "test_util.h"
+#include "scene_test_util.h"
 
 #include <hairvox/core/error.h>
 #include <hairvox/film/image_compare.h>
@@ -42,15 +43,11 @@ double layerSum(const Film& film, const std::string& name) {
     return sum;
 }
 
+/// The error of the default scene with this integrator object.
 std::string errorOf(const nlohmann::json& integrator) {
     nlohmann::json j = nlohmann::json::parse(defaultSceneJson());
     j["integrator"] = integrator;
-    try {
-        parseScene(j, "scene.json", "/");
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "";
+    return test::sceneErrorOf(j);
 }
 
 TEST(Volumetric, SceneKeysAreReadAndCheckedPerIntegrator) {

@@ -24,4 +24,8 @@ void writeFileAtomically(const std::filesystem::path& finalPath,
 /// lost); it is never an output.
 std::string temporaryPrefix(const std::filesystem::path& finalPath);
 
+/// Whether two paths name the same file: textually (absolute, normalised), or
+/// the same existing file — what an output must not be of an input.
+bool sameFile(const std::filesystem::path& a, const std::filesystem::path& b);
+
 } // namespace hairvox
