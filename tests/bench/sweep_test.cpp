@@ -6,8 +6,10 @@
 #include <hairvox/bench/sweep.h>
 #include <hairvox/core/error.h>
 #include <hairvox/core/rng.h>
+#include <hairvox/shading/simd.h>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <cstring>
@@ -248,6 +250,23 @@ TEST(BenchSweep, TinySweepWritesTablesAndPlots) {
         EXPECT_TRUE(std::isfinite(fit.total->exponent));
         EXPECT_FALSE(fit.peakMemory);
     }
+
+    // The host (bench/host): host.json's figures, and results.md's header names it.
+    std::ifstream hostFile(o.outDir / "host.json");
+    const nlohmann::json host = nlohmann::json::parse(hostFile);
+    EXPECT_EQ(host.at("simd_target").get<std::string>(), simdTarget());
+    EXPECT_FALSE(host.at("cpu_model").get<std::string>().empty());
+    EXPECT_GE(host.at("logical_cores").get<unsigned>(), 1u);
+    for (const char* key : {"simd_fma_flops_per_second", "dram_bytes_per_second",
+                            "miss_latency_ns", "baseline_flops_per_second"})
+        EXPECT_GT(host.at(key).get<double>(), 0.0) << key;
+    std::ifstream header(o.outDir / "results.md");
+    std::string line;
+    bool named = false;
+    while (std::getline(header, line) && !named)
+        named = line.rfind("Host: " + host.at("cpu_model").get<std::string>(), 0) == 0 &&
+                line.find("SIMD " + simdTarget()) != std::string::npos;
+    EXPECT_TRUE(named) << "results.md: no line \"Host: <cpu>, ..., SIMD <target>\"";
 
     std::ifstream md(o.outDir / "results.md");
     const std::string text((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());

@@ -42,7 +42,7 @@ private:
     std::filesystem::path path_;
 };
 
-/// Writes results.csv, results.md, scaling_fits.csv and the plots.
+/// Writes results.csv, results.md, scaling_fits.csv, host.json and the plots.
 std::vector<std::filesystem::path> writeSweepOutputs(const SweepOptions& o, SweepResult& result,
                                                      const RunInfo& info,
                                                      const std::filesystem::path& workDir) {
@@ -55,6 +55,7 @@ std::vector<std::filesystem::path> writeSweepOutputs(const SweepOptions& o, Swee
     writeText(o.outDir / "results.csv", csvText(result.rows));
     writeText(o.outDir / "results.md", markdownText(o, result, info));
     writeText(o.outDir / "scaling_fits.csv", fitsCsvText(result.fits));
+    writeText(o.outDir / "host.json", hostJsonText(info));
     const PlotResult plots = drawPlots(o.outDir, workDir);
     if (!plots.problem.empty() && o.log)
         *o.log << "bench: warning: no plots drawn: " << plots.problem << std::endl;

@@ -62,6 +62,7 @@
 //
 // Outputs in SweepOptions::outDir, rewritten after each scene:
 //   results.csv            one row per measured configuration (kBenchCsvColumns)
+//   host.json              the machine (bench/host: CPU, cores, SIMD target, calibration)
 //   results.md             the tables: summary, per scene, scaling with exponents
 //   scaling_fits.csv       the fitted growth exponents
 //   runtime_vs_error.png   total time against image error, one curve (the
