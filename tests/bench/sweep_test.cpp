@@ -287,7 +287,7 @@ TEST(BenchSweep, TinySweepWritesTablesAndPlots) {
     EXPECT_EQ(pngSize(o.outDir / "runtime_vs_error.png"), std::make_pair(1540u, 715u));
     EXPECT_EQ(pngSize(o.outDir / "scaling.png"), std::make_pair(2520u, 624u));
     // The frontier: one scene (a row) × two hair colours (columns).
-    EXPECT_EQ(pngSize(o.outDir / "frontier.png"), std::make_pair(1040u, 440u));
+    EXPECT_EQ(pngSize(o.outDir / "frontier.png"), std::make_pair(1040u, 500u));
     EXPECT_FALSE(std::filesystem::exists(o.outDir / ".work")) << "working files are removed";
 }
 
