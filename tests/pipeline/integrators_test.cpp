@@ -3,8 +3,9 @@
 // exact global term's one shadow ray, V·f_s·cos θ_i. The same camera,
 // coverage, lights, shadows and f_s, measured against the path tracer's own
 // noise. The rasterizer is rendered finer than the path tracer: at the
-// reference's resolution its per-pixel compositing of many partly covering
-// strands (as if independent) is what differs, not the light transport.
+// reference's resolution its one shading point per fragment and its
+// compositing of a pixel's partly covering strands as if independent are what
+// differ, not the light transport (docs/DESIGN.md §8).
 #include "test_util.h"
 
 #include <hairvox/core/math.h>
@@ -122,9 +123,10 @@ Scene sceneAt160(const char* file, float k) {
 /// Issue 36 §3: on real grooms at low resolution with a large density
 /// multiplier (ribbons 0.04–0.14 pixel wide, several strands a pixel) depth-1
 /// path tracing is the rasterizer's single scattering within 2% over 8×8
-/// blocks — once the rasterizer is rendered fine enough that its pixels'
-/// compositing of partial coverages has converged (Ratboy at 160²: 0.047 at
-/// the same resolution, 0.033, 0.021, 0.013 at 2×, 4×, 8×; DESIGN §8).
+/// blocks — once the rasterizer is rendered fine enough that its estimate of
+/// a pixel (a point per fragment, partial coverages composited) has converged
+/// (Ratboy at 160²: 0.047 at the same resolution, 0.033, 0.021, 0.013 at 2×,
+/// 4×, 8×; docs/DESIGN.md §8).
 void expectDepth1Within2Percent(const char* name, const Scene& scene, int super) {
     test::TempDir dir;
     const Depth1 r = compareDepth1(scene, dir, 256, super, 8);
