@@ -29,6 +29,7 @@
 // Path-traced references are written to DIR (default out/environment_bench)
 // and reused while their scene is unchanged (the render hash in the EXR).
 // --quick: smaller images and fewer samples (a smoke run, not the figures).
+#include <hairvox/bench/host_report.h>
 #include <hairvox/core/error.h>
 #include <hairvox/core/math.h>
 #include <hairvox/film/image_compare.h>
@@ -573,6 +574,7 @@ int main(int argc, char** argv) {
     std::filesystem::create_directories(o.out);
     std::printf("# hairvox environment light (environment_bench%s), load average %s\n",
                 o.quick ? " --quick" : "", loadAverage().c_str());
+    std::printf("host: %s\n", bench::HostReport::measure().line().c_str());
     try {
         if (o.sections.count("identities"))
             identities(o);

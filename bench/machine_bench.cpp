@@ -189,5 +189,3 @@ BENCHMARK(BM_PeakFma)->Arg(0)->Arg(1)->Threads(1)->Threads(2)->UseRealTime()->Un
     benchmark::kMillisecond);
 
 } // namespace
-
-BENCHMARK_MAIN();

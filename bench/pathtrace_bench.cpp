@@ -198,5 +198,3 @@ BENCHMARK(BM_PathTrace512)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterat
 
 } // namespace
 } // namespace hairvox
-
-BENCHMARK_MAIN();

@@ -192,5 +192,3 @@ BENCHMARK(BM_WriteOutput)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRea
 
 } // namespace
 } // namespace hairvox
-
-BENCHMARK_MAIN();

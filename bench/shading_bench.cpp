@@ -192,5 +192,3 @@ BENCHMARK(BM_DualScatteringTablesBuild)->ArgsProduct({{1, 2}, {0, 1}})->ArgNames
 
 } // namespace
 } // namespace hairvox
-
-BENCHMARK_MAIN();

@@ -215,5 +215,3 @@ BENCHMARK(ProbeAccuracy)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1)
 
 } // namespace
 } // namespace hairvox
-
-BENCHMARK_MAIN();

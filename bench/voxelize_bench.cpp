@@ -112,5 +112,3 @@ BENCHMARK(BM_SplatWavyTensor)->Arg(50000)->Unit(benchmark::kMillisecond)->UseRea
 
 } // namespace
 } // namespace hairvox
-
-BENCHMARK_MAIN();

@@ -11,6 +11,10 @@ and writes
                                    with each scene's Pareto front
     OUT_DIR/scaling.png            stage times against segment count, image size and
                                    active voxels, with the fitted power laws
+    OUT_DIR/frontier.png           the model sweep's time against error, a panel per
+                                   scene and hair colour: dual scattering, the volumetric
+                                   integrator over its budgets, the path tracer over its
+                                   samples, per pixel and over block means
 
 The benchmark (bench/sweep) calls it after writing the CSV files; it can be
 rerun by hand on a results directory. Only reads the CSVs: every number is the
@@ -23,6 +27,7 @@ import sys
 import matplotlib
 
 matplotlib.use("Agg")
+import matplotlib.patches  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 
 MARKERS = {"exact": "o", "grid": "s", "approx": "^"}
@@ -152,6 +157,90 @@ def plot_scaling(rows, fits, path):
     return True
 
 
+def split_cell(label):
+    """'wavy (default scene), blond' -> ('wavy (default scene)', 'blond')."""
+    scene, _, hair = label.rpartition(", ")
+    return (scene, hair) if scene else (label, "")
+
+
+def plot_frontier(rows, path):
+    """Time against the hair's error with the reference's noise removed, one
+    panel per scene (row) and hair colour (column). Solid lines and filled
+    markers: per pixel; dashed and hollow: over block means. Dotted: the
+    reference's own floor (per pixel, blocks); an error below it is not
+    resolved. The grey band is the 5% target."""
+    model = [r for r in rows if r["sweep"] == "model" and number(r, "rel_l1_noise_removed")
+             is not None]
+    if not model:
+        return False
+    references = {r["scene"]: r for r in rows if r["sweep"] == "path_reference"}
+    cells = list(dict.fromkeys(r["scene"] for r in model))
+    scenes = list(dict.fromkeys(split_cell(c)[0] for c in cells))
+    hairs = list(dict.fromkeys(split_cell(c)[1] for c in cells))
+    fig, axes = plt.subplots(len(scenes), len(hairs), figsize=(5.2 * len(hairs), 4.4 * len(scenes)),
+                             dpi=100, squeeze=False, sharex=True, sharey=True)
+    colours = {"exact": "#7f7f7f", "grid": "#1f77b4", "approx": "#9467bd",
+               "volumetric": "#d62728", "path": "#2ca02c"}
+    lowest = 1e-3  # errors at or under it (fully within the noise) are drawn here
+    block = next((r["block"] for r in model if r.get("block")), "")
+    for cell in cells:
+        scene, hair = split_cell(cell)
+        ax = axes[scenes.index(scene)][hairs.index(hair)]
+        mine = [r for r in model if r["scene"] == cell]
+        for key, style, fill in (("rel_l1_noise_removed", "-", True),
+                                 ("block_rel_l1_noise_removed", "--", False)):
+            for method in ("exact", "grid", "approx", "volumetric", "path"):
+                series = sorted((number(r, "total_s"), max(number(r, key) or 0.0, lowest), r)
+                                for r in mine if r["mode"] == method and number(r, key)
+                                is not None)
+                if not series:
+                    continue
+                colour = colours[method]
+                marker = MARKERS.get(method, "o" if method == "path" else "D")
+                ax.plot([p[0] for p in series], [p[1] for p in series], ls=style if
+                        len(series) > 1 else "", marker=marker, color=colour, ms=5,
+                        mfc=colour if fill else "none", lw=1.1)
+                for t, e, r in series if fill else ():
+                    text = (r["spp"] if method == "path" else
+                            "%g" % float(r["paths_per_cell"]) if method == "volumetric" else "")
+                    if text:
+                        ax.annotate(text, (t, e), textcoords="offset points", xytext=(3, 3),
+                                    fontsize=7, color=colour)
+        reference = references.get(cell)
+        floors = [number(r, k) for r in mine[:1] for k in ("noise_floor_l1", "block_noise_floor_l1")]
+        for floor in floors:
+            if floor:
+                ax.axhline(floor, color="#bbbbbb", lw=0.8, ls=":")
+        ax.axhspan(lowest, 0.05, color="#f2f2f2", zorder=0)
+        title = cell + (" — reference %s spp, %.0f s" % (reference["spp"],
+                                                          number(reference, "total_s"))
+                        if reference else "")
+        ax.set_title(title, fontsize=9)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.grid(True, which="both", color="#e4e4e4", lw=0.6)
+    for ax in axes[-1]:
+        ax.set_xlabel("end-to-end time, s")
+    for row in axes:
+        row[0].set_ylabel("rel L1 of the hair, noise removed")
+    handles = [plt.Line2D([], [], color=c, marker=MARKERS.get(m, "o" if m == "path" else "D"),
+                          ls="", label={"path": "path tracing (label: spp)",
+                                        "volumetric": "volumetric (label: paths/cell)"}.get(
+                              m, "dual scattering, " + m)) for m, c in colours.items()]
+    handles += [plt.Line2D([], [], color="gray", ls="-", marker="o", label="per pixel"),
+                plt.Line2D([], [], color="gray", ls="--", marker="o", mfc="none",
+                           label="over %s×%s-pixel block means" % (block, block)),
+                plt.Line2D([], [], color="#bbbbbb", ls=":", label="reference's noise floor"),
+                matplotlib.patches.Patch(color="#f2f2f2", label="within 5%")]
+    fig.legend(handles=handles, loc="lower center", ncol=5, fontsize=8)
+    fig.suptitle("hairvox: time against error of each method (the path tracer's own error "
+                 "is its noise)")
+    fig.tight_layout(rect=(0, 0.06, 1, 0.97))
+    fig.savefig(path)
+    plt.close(fig)
+    return True
+
+
 def main():
     if len(sys.argv) != 2:
         sys.exit("usage: plot_sweep.py OUT_DIR")
@@ -161,7 +250,8 @@ def main():
     fits = read_csv(fits_path) if os.path.exists(fits_path) else []
     # Written under temporary names and renamed: a plot is never half-written.
     for name, draw in (("runtime_vs_error.png", lambda p: plot_runtime_vs_error(rows, p)),
-                       ("scaling.png", lambda p: plot_scaling(rows, fits, p))):
+                       ("scaling.png", lambda p: plot_scaling(rows, fits, p)),
+                       ("frontier.png", lambda p: plot_frontier(rows, p))):
         final = os.path.join(out, name)
         tmp = os.path.join(out, "." + name + ".tmp.png")
         if draw(tmp):

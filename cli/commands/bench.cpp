@@ -1,5 +1,6 @@
 // hairvox bench [--scene FILE ...] [--out DIR] [--quick] [--threads N] [--runs N] [--no-scaling]
-//               [--no-accuracy] [--no-model]
+//               [--no-accuracy] [--no-model] [--hair NAME ...] [--model-spp N]
+//               [--frontier-spp N ...] [--frontier-paths N ...]
 // Sweeps global-term mode × voxel size × shading rate against exact-mode
 // references, dual scattering against the path tracer (the model sweep), then
 // time and memory against segment count, image size and active voxels
@@ -11,6 +12,7 @@
 #include <hairvox/bench/sweep.h>
 #include <hairvox/core/error.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -31,6 +33,10 @@ struct BenchOptions {
     bool noScaling = false;
     bool noModel = false;
     bool noAccuracy = false;
+    std::vector<std::string> hair;
+    std::optional<std::uint32_t> modelSpp;
+    std::optional<std::vector<std::uint32_t>> frontierSpp;
+    std::optional<std::vector<float>> frontierPaths;
     std::string job;
 };
 
@@ -52,6 +58,16 @@ std::string commandLine(const BenchOptions& opt) {
         line += " --no-model";
     if (opt.noAccuracy)
         line += " --no-accuracy";
+    for (const std::string& h : opt.hair)
+        line += " --hair " + h;
+    if (opt.modelSpp)
+        line += " --model-spp " + std::to_string(*opt.modelSpp);
+    if (opt.frontierSpp)
+        for (const std::uint32_t n : *opt.frontierSpp)
+            line += " --frontier-spp " + std::to_string(n);
+    if (opt.frontierPaths)
+        for (const float n : *opt.frontierPaths)
+            line += strCat(" --frontier-paths ", n);
     return line;
 }
 
@@ -86,6 +102,24 @@ void runBench(const BenchOptions& opt) {
         sweep.pixelScaling.clear();
         sweep.voxelScaling.clear();
     }
+    if (!opt.hair.empty()) {
+        std::vector<std::pair<std::string, float>> melanins;
+        for (const std::string& name : opt.hair) {
+            const auto known =
+                std::find_if(sweep.model.melanins.begin(), sweep.model.melanins.end(),
+                             [&](const auto& m) { return m.first == name; });
+            if (known == sweep.model.melanins.end())
+                throw InputError(strCat("bench --hair ", name, ": expected blond, medium or dark"));
+            melanins.push_back(*known);
+        }
+        sweep.model.melanins = melanins;
+    }
+    if (opt.modelSpp)
+        sweep.model.spp = *opt.modelSpp;
+    if (opt.frontierSpp)
+        sweep.model.frontierSpp = *opt.frontierSpp;
+    if (opt.frontierPaths)
+        sweep.model.frontierPathsPerCell = *opt.frontierPaths;
     if (opt.runs)
         sweep.runs = *opt.runs;
     sweep.threads = opt.threads;
@@ -122,6 +156,20 @@ void addBenchCommand(CLI::App& app) {
                   "Skip the accuracy sweep (modes and voxel sizes against exact mode)");
     cmd->add_flag("--no-model", opt->noModel,
                   "Skip the model sweep (dual scattering against the path tracer)");
+    cmd->add_option("--hair", opt->hair,
+                    "The model sweep's hair colours (blond, medium, dark; default all three)");
+    cmd->add_option("--model-spp", opt->modelSpp,
+                    "Samples per pixel of the model sweep's path-traced references (default 1024; "
+                    "--quick: 64)")
+        ->check(CLI::Range(2, 1000000));
+    cmd->add_option("--frontier-spp", opt->frontierSpp,
+                    "The frontier's path tracer at these samples per pixel, each below --model-spp "
+                    "(default 4 16 64 256; --quick: 4 16)")
+        ->expected(0, -1);
+    cmd->add_option("--frontier-paths", opt->frontierPaths,
+                    "The frontier's volumetric integrator also at these paths per cache cell "
+                    "(default 3 48; --quick: 4)")
+        ->expected(0, -1);
     cmd->add_option("--one", opt->job, "Run one job of a sweep (internal)")->group("");
     cmd->callback([opt] { runBench(*opt); });
 }

@@ -1,18 +1,15 @@
-#include "asset_cache.h"
 #include "dual_scattering_fragment_shader.h"
 #include "environment_lights.h"
 #include "frame_reuse.h"
+#include "scene_assets.h"
 #include "surfaces.h"
 
 #include <hairvox/core/error.h>
 #include <hairvox/core/format.h>
 #include <hairvox/core/hash.h>
-#include <hairvox/core/interrupt.h>
 #include <hairvox/core/parallel.h>
 #include <hairvox/film/image_file.h>
 #include <hairvox/pipeline/pipeline.h>
-#include <hairvox/strands/groom_io.h>
-#include <hairvox/transmittance/exact_global_term.h>
 
 #include <algorithm>
 #include <chrono>
@@ -61,11 +58,10 @@ void warnAboutLights(const Scene& scene, const SceneSurfaces& surfaces,
                 scene.head->sphere.radius, "); it lights nothing and is skipped"));
         } else if (light.kind == Light::Kind::Point && surfaces.scene &&
                    surfaces.scene->contains(light.position)) {
-            warnings.push_back(strCat("light '", light.name, "' at ", vecText(light.position),
-                                      " is inside a mesh (bounds ",
-                                      vecText(surfaces.scene->bounds().min), " to ",
-                                      vecText(surfaces.scene->bounds().max),
-                                      "); it lights nothing and is skipped"));
+            warnings.push_back(strCat(
+                "light '", light.name, "' at ", vecText(light.position),
+                " is inside a mesh (bounds ", vecText(surfaces.scene->bounds().min), " to ",
+                vecText(surfaces.scene->bounds().max), "); it lights nothing and is skipped"));
         }
     }
 }
@@ -199,24 +195,6 @@ MemoryEstimate estimateRenderMemory(const Scene& scene) {
     return m;
 }
 
-std::shared_ptr<const EnvironmentMap> loadEnvironment(const Scene& scene, std::uint64_t maxBytes) {
-    if (!scene.environment)
-        return nullptr;
-    const EnvironmentLight& e = *scene.environment;
-    const Rgb scale = e.intensity * e.color;
-    try {
-        if (e.file.empty()) {
-            EnvironmentMap uniform = EnvironmentMap::uniform(scale);
-            return std::make_shared<const EnvironmentMap>(std::move(uniform));
-        }
-        return std::make_shared<const EnvironmentMap>(
-            EnvironmentMap::readExr(e.file, scale, e.rotation, maxBytes));
-    } catch (const InputError& error) {
-        throw InputError(
-            strCat(scene.name, ": environment light \"", e.name, "\": ", error.what()));
-    }
-}
-
 namespace {
 
 /// What the report says of the map itself.
@@ -231,259 +209,6 @@ void describeEnvironment(const EnvironmentMap& map, const Scene& scene, Environm
 
 } // namespace
 
-void checkVoxelSizeForGroom(const Scene& scene, const Groom& groom) {
-    if (!scene.voxelSize || groom.empty())
-        return;
-    const Vec3f extent = groom.bounds().extent();
-    const float longest = std::max({extent.x, extent.y, extent.z});
-    if (!(longest > 0))
-        return;
-    const float h = *scene.voxelSize;
-    if (longest < 2 * h)
-        throw InputError(
-            strCat(scene.name, ": grid.voxel_size = ", h,
-                   " is too large for the groom: its bounding box is ", extent.x, " x ", extent.y,
-                   " x ", extent.z, ", ", longest / h,
-                   " voxel(s) along its longest side (at least 2 are needed to resolve the hair; "
-                   "the default, \"auto\", is the longest side / ",
-                   kDefaultVoxelsAcross, " = ", longest / float(kDefaultVoxelsAcross), ")"));
-}
-
-SceneSurfaces loadSurfaces(const Scene& scene) {
-    SceneSurfaces out;
-    std::vector<Sphere> spheres;
-    if (scene.head) {
-        spheres.push_back(scene.head->sphere);
-        out.albedo.push_back(scene.head->albedo);
-    }
-    std::vector<TriangleMesh> meshes;
-    for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
-        const MeshSource& source = scene.meshes[i];
-        try {
-            if (source.isMannequin()) {
-                meshes.push_back(generateHeadMesh(source.mannequin, source.mannequinRings));
-            } else {
-                LoadedMesh loaded = readObjMesh(source.file);
-                meshes.push_back(std::move(loaded.mesh));
-                for (std::string& w : loaded.warnings)
-                    out.warnings.push_back(std::move(w));
-            }
-        } catch (const InputError& e) {
-            throw InputError(strCat(scene.name, ": meshes[", i, "]: ", e.what()));
-        }
-        source.transform.apply(meshes.back());
-        out.albedo.push_back(source.albedo);
-        throwIfInterrupted();
-    }
-    if (!spheres.empty() || !meshes.empty())
-        out.scene = std::make_shared<const SurfaceScene>(std::move(spheres), std::move(meshes));
-    return out;
-}
-
-GlobalTermSettings globalTermSettings(const Scene& scene, const SceneSurfaces& surfaces) {
-    GlobalTermSettings s;
-    s.fiberScale = scene.fiberScale;
-    s.dualScattering = scene.dualScattering;
-    s.surfaces = surfaces.scene;
-    return s;
-}
-
-RasterSettings rasterSettings(const Scene& scene, const PipelineOptions& options) {
-    RasterSettings s;
-    s.fiberScale = scene.fiberScale;
-    s.shadingRate = scene.shadingRate;
-    s.shadingTolerance = scene.shadingTolerance;
-    s.tailTransmittance = scene.tailTransmittance;
-    s.background = scene.background;
-    s.layers = scene.output.layers;
-    s.threads = options.threads;
-    s.progress = options.progress;
-    return s;
-}
-
-SceneGroom loadGroom(const Scene& scene) {
-    SceneGroom g;
-    const bool procedural = scene.groom.isProcedural();
-    const std::string source = procedural ? "procedural groom" : scene.groom.sourceName();
-    SanitizeReport sanitized;
-    if (procedural) {
-        g.groom = generateGroom(scene.groom.procedural);
-    } else if (scene.groom.inMemory) {
-        g.groom = *scene.groom.inMemory; // its attributes are resolved below, in this copy
-        sanitized = sanitizeGroom(g.groom, source);
-    } else {
-        LoadedGroom loaded = readGroom(scene.groom.file);
-        g.warnings = std::move(loaded.warnings);
-        sanitized = loaded.sanitized;
-        g.groom = std::move(loaded.groom);
-    }
-    if (sanitized.droppedSegments > 0)
-        g.warnings.push_back(
-            strCat("dropped ", sanitized.droppedSegments, " zero-length segment(s)"));
-    if (sanitized.droppedStrands > 0)
-        g.warnings.push_back(strCat("dropped ", sanitized.droppedStrands, " degenerate strand(s)"));
-    if (std::string note = resolveThickness(g.groom, scene.groom.thickness, scene.fiberScale,
-                                            source, g.warnings);
-        !note.empty())
-        g.notes.push_back(std::move(note));
-    g.palette = resolveColors(g.groom, scene.groom.color, scene.fiber, source, g.warnings);
-    if (!g.palette.colors.empty())
-        g.notes.push_back(strCat(g.palette.size(), " fiber type(s) from the ",
-                                 procedural             ? "procedural groom's"
-                                 : scene.groom.inMemory ? "groom's"
-                                                        : "file's",
-                                 " colours (groom.color \"use\"): sigma_a replaces the scene's"));
-    else if (!g.groom.color.empty())
-        g.notes.push_back("per-point colours ignored (groom.color \"ignore\")");
-    if (!g.groom.transparency.empty())
-        g.warnings.push_back(strCat(source, " carries per-point transparency, which hairvox does "
-                                            "not render: every fiber is opaque"));
-    return g;
-}
-
-namespace {
-
-SplatOptions splatOptions(const Scene& scene, const PipelineOptions& options) {
-    SplatOptions splat;
-    splat.voxelSize = scene.voxelSize.value_or(0.0f);
-    splat.fiberScale = scene.fiberScale;
-    splat.storeOrientationTensor = options.grid.orientation == OrientationModel::Tensor;
-    splat.sourceFile = scene.groom.sourceName();
-    splat.showProgress = options.progress;
-    if (options.maxMemoryBytes > 0) {
-        const std::uint64_t used = estimateRenderMemory(scene).total();
-        splat.memoryBudgetBytes = std::min(
-            splat.memoryBudgetBytes, options.maxMemoryBytes > used ? options.maxMemoryBytes - used : 1);
-    }
-    return splat;
-}
-
-/// What prepareAssets() did: built the assets, or found them all in the
-/// frame before (then `reused` says which), and the keys it built them under.
-struct FrameAssets {
-    const SceneAssets* reused = nullptr;
-    bool gridReused = false;
-    std::uint64_t gridKey = 0, modelKey = 0; ///< when reuse was asked for
-};
-
-/// loadSceneAssets() into `assets` (empty, where they will stay: the model
-/// refers to their grid and groom), taking from `reuse` (when given) the
-/// grid, or every asset of the frame before, where their keys match, and
-/// dropping the rest of the frame before before allocating anew.
-FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, SceneAssets* assets,
-                          FrameReuse::State* reuse) {
-    FrameAssets out;
-    auto start = Clock::now();
-    assets->groom = loadGroom(scene);
-    assets->surfaces = loadSurfaces(scene);
-    const auto environmentStart = Clock::now();
-    assets->environment = loadEnvironment(scene);
-    assets->environmentLoadSeconds = secondsSince(environmentStart);
-    assets->times.load = secondsSince(start);
-    throwIfInterrupted();
-
-    const DiskCache* disk = options.diskCache.get();
-    const bool keyed = reuse || disk;
-    const std::uint64_t groom = keyed ? detail::groomKey(assets->groom.groom) : 0;
-    if (scene.globalTermMode != GlobalTermMode::Exact || scene.integrator == Integrator::Volumetric) {
-        checkVoxelSizeForGroom(scene, assets->groom.groom);
-        const SplatOptions splat = splatOptions(scene, options);
-        if (keyed)
-            out.gridKey = detail::gridKey(groom, splat);
-        if (reuse && reuse->assets && reuse->assets->grid && reuse->gridKey == out.gridKey) {
-            out.gridReused = true;
-        } else {
-            if (reuse)
-                reuse->release();
-            start = Clock::now();
-            assets->grid = std::make_shared<const FiberGrid>(
-                disk ? detail::splatOrLoad(assets->groom.groom, splat, *disk, out.gridKey,
-                                           options.diskCacheStoresGrid)
-                     : splatStrands(assets->groom.groom, splat));
-            assets->times.voxelize = secondsSince(start);
-        }
-    }
-    if (keyed)
-        out.modelKey = detail::modelKey(groom, out.gridKey, scene, options, assets->groom,
-                                        assets->surfaces, assets->environment.get());
-    if (reuse) {
-        if (reuse->assets && reuse->modelKey == out.modelKey) {
-            // The same groom, surfaces, grid and model: the frame before's.
-            out.reused = reuse->assets.get();
-            return out;
-        }
-        if (out.gridReused) // shared, not copied
-            assets->grid = reuse->assets->grid;
-        reuse->release();
-    }
-
-    start = Clock::now();
-    TableBuildOptions tableOptions;
-    tableOptions.d_b = scene.dualScattering.d_b;
-    // The tables' own disk cache: given, or beside the shared grids and lights.
-    std::filesystem::path tableCacheDir = options.tableCacheDir;
-    if (tableCacheDir.empty())
-        tableCacheDir = disk ? disk->directory() : defaultTableCacheDir();
-    CrossingTables crossings;
-    for (const FiberParams& fiber : assets->groom.palette.fibers) {
-        assets->tables.push_back(
-            DualScatteringTables::loadOrBuild(fiber, tableCacheDir, tableOptions));
-        crossings.push_back(CrossingTable::fromDualScattering(assets->tables.back()));
-    }
-    assets->times.tables = secondsSince(start);
-
-    start = Clock::now();
-    GlobalTermSettings settings = globalTermSettings(scene, assets->surfaces);
-    settings.groom = &assets->groom.groom;
-    settings.diskCache = disk;
-    settings.diskCacheKey = out.modelKey;
-    if (!options.diskCacheSkipsLights.empty())
-        settings.diskCacheStores = [skip = options.diskCacheSkipsLights](const Light& light) {
-            return skip.count(light.name) == 0;
-        };
-    GridOptions gridOptions = options.grid;
-    if (scene.fiberSampleSpacing)
-        gridOptions.fiberSampleSpacing = *scene.fiberSampleSpacing;
-    ExactOptions exact;
-    exact.rays = static_cast<int>(scene.exact.rays);
-    exact.radius = scene.exact.radius;
-    exact.seed = scene.exact.seed;
-    const auto makeModel = [&](CrossingTables tables, const GlobalTermSettings& s,
-                               const GridOptions& grid) -> std::unique_ptr<GlobalTermModel> {
-        switch (scene.globalTermMode) {
-        case GlobalTermMode::Exact:
-            return makeExactModel(assets->groom.groom, std::move(tables), s, exact);
-        case GlobalTermMode::Grid:
-            return makeGridModel(*assets->grid, std::move(tables), s, grid);
-        case GlobalTermMode::Approx:
-            return makeApproxModel(*assets->grid, std::move(tables), s, grid);
-        }
-        throw std::logic_error("unknown global-term mode");
-    };
-    if (assets->environment) {
-        // The environment's regions: a coarser cache, each query evaluated
-        // as it is (no surfaces' shadow, no samples along the fibers: the
-        // integrator adds both, environmentHairTerm()).
-        GlobalTermSettings open = settings;
-        open.surfaces = nullptr;
-        open.groom = nullptr;
-        GridOptions grid = gridOptions;
-        grid.cacheSpacing = options.environment.cacheSpacing;
-        assets->environmentTerm = makeModel(crossings, open, grid);
-    }
-    assets->globalTerm = makeModel(std::move(crossings), settings, gridOptions);
-    assets->times.globalTerm = secondsSince(start);
-    return out;
-}
-
-} // namespace
-
-std::unique_ptr<SceneAssets> loadSceneAssets(const Scene& scene, const PipelineOptions& options) {
-    auto assets = std::make_unique<SceneAssets>();
-    prepareAssets(scene, options, assets.get(), nullptr);
-    return assets;
-}
-
 namespace {
 
 /// The volumetric integrator's multiple scattering: solved on the fiber grid
@@ -491,8 +216,8 @@ namespace {
 /// unchanged (`key`).
 std::shared_ptr<const MultipleScatteringSolution>
 solveMultiple(const Scene& scene, const PipelineOptions& options, const SceneAssets& assets,
-              std::span<const Light> environmentLights, FrameReuse::State* reuse,
-              std::uint64_t key, bool& reused) {
+              std::span<const Light> environmentLights, FrameReuse::State* reuse, std::uint64_t key,
+              bool& reused) {
     reused = false;
     if (reuse && reuse->multiple && reuse->multipleKey == key) {
         reused = true;
@@ -528,7 +253,7 @@ SceneRender renderRasterized(const Scene& scene, const PipelineOptions& options,
                              FrameReuse::State* reuse) {
     SceneRender result;
     auto built = std::make_shared<SceneAssets>();
-    const FrameAssets frame = prepareAssets(scene, options, built.get(), reuse);
+    const detail::FrameAssets frame = detail::prepareAssets(scene, options, built.get(), reuse);
     const SceneAssets* assets = frame.reused ? frame.reused : built.get();
     if (frame.reused) {
         result.times.load = built->times.load;
@@ -718,11 +443,11 @@ SceneRender renderRasterized(const Scene& scene, const PipelineOptions& options,
         shadedEnvironment.lights = environment->lights;
         shadedEnvironment.spread2 = environment->spread2;
         for (std::size_t l = 0; l < environmentCount; ++l)
-            shadedEnvironment.terms.push_back(
-                environmentTerms[l] ? std::make_shared<detail::RegionSurfaceShadow>(
-                                          environmentTerms[l], assets->surfaces.scene,
-                                          environment->shadowDirections[l])
-                                    : nullptr);
+            shadedEnvironment.terms.push_back(environmentTerms[l]
+                                                  ? std::make_shared<detail::RegionSurfaceShadow>(
+                                                        environmentTerms[l], assets->surfaces.scene,
+                                                        environment->shadowDirections[l])
+                                                  : nullptr);
         if (assets->grid) {
             shadedEnvironment.groom = &assets->groom.groom;
             shadedEnvironment.spacing = options.environment.fiberSampleSpacing *
@@ -780,7 +505,8 @@ SceneRender renderRasterized(const Scene& scene, const PipelineOptions& options,
     if (assets->grid)
         result.outputAttributes["hairvox:voxel_size"] =
             std::to_string(assets->grid->info.voxelSize);
-    result.outputAttributes.insert(options.outputAttributes.begin(), options.outputAttributes.end());
+    result.outputAttributes.insert(options.outputAttributes.begin(),
+                                   options.outputAttributes.end());
     if (writeFiles) {
         const auto start = Clock::now();
         result.written = writeOutputs(result.film, scene, result.outputAttributes);
@@ -863,7 +589,8 @@ SceneRender renderPathTraced(const Scene& scene, const PipelineOptions& options,
     result.outputAttributes = {{"hairvox:spp", std::to_string(traced.stats.spp)},
                                {"hairvox:seed", std::to_string(scene.pathTrace.seed)},
                                {"hairvox:pathTraceHash", hash}};
-    result.outputAttributes.insert(options.outputAttributes.begin(), options.outputAttributes.end());
+    result.outputAttributes.insert(options.outputAttributes.begin(),
+                                   options.outputAttributes.end());
     if (writeFiles && traced.stats.spp > previousSpp) {
         start = Clock::now();
         result.written = writeOutputs(result.film, scene, result.outputAttributes);
@@ -882,16 +609,15 @@ SceneRender renderScene(const Scene& scene, const PipelineOptions& options, bool
         options.maxMemoryBytes > 0 ? options.maxMemoryBytes : defaultMemoryLimit();
     const MemoryEstimate memory = estimateRenderMemory(scene);
     if (memory.total() > limit)
-        throw InputError(strCat(scene.name, ": a ", scene.camera.width, " x ", scene.camera.height,
-                                " render would need about ", gib(double(memory.total())),
-                                " (film: ", memory.filmChannels,
-                                " float channels per pixel and the integrator's buffers, ",
-                                gib(double(memory.film)), "; groom: ", gib(double(memory.groom)),
-                                "; meshes: ", gib(double(memory.meshes)),
-                                "; the rest: ", gib(double(memory.fixed)),
-                                "), over the memory limit of ", gib(double(limit)),
-                                options.maxMemoryBytes > 0 ? "" : " (3/4 of the physical memory)",
-                                "; lower the resolution or raise the limit (--max-memory GiB)"));
+        throw InputError(strCat(
+            scene.name, ": a ", scene.camera.width, " x ", scene.camera.height,
+            " render would need about ", gib(double(memory.total())),
+            " (film: ", memory.filmChannels,
+            " float channels per pixel and the integrator's buffers, ", gib(double(memory.film)),
+            "; groom: ", gib(double(memory.groom)), "; meshes: ", gib(double(memory.meshes)),
+            "; the rest: ", gib(double(memory.fixed)), "), over the memory limit of ",
+            gib(double(limit)), options.maxMemoryBytes > 0 ? "" : " (3/4 of the physical memory)",
+            "; lower the resolution or raise the limit (--max-memory GiB)"));
     PipelineOptions withLimit = options;
     withLimit.maxMemoryBytes = limit;
     const ThreadLimit threadLimit(options.threads);
@@ -909,8 +635,9 @@ std::vector<std::string> hairRadianceLayers(const Film& film) {
         layers.emplace_back("back_direct");
         layers.emplace_back("scatter");
     } else {
-        throw std::out_of_range("the image has neither layer 'multiple' (path tracer, volumetric) nor the "
-                                "dual-scattering layers 'back_direct' and 'scatter'");
+        throw std::out_of_range(
+            "the image has neither layer 'multiple' (path tracer, volumetric) nor the "
+            "dual-scattering layers 'back_direct' and 'scatter'");
     }
     return layers;
 }

@@ -6,8 +6,10 @@
 #include <hairvox/bench/sweep.h>
 #include <hairvox/core/error.h>
 #include <hairvox/core/rng.h>
+#include <hairvox/shading/simd.h>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <cstring>
@@ -151,14 +153,17 @@ TEST(BenchSweep, TinySweepWritesTablesAndPlots) {
     o.model.modes = {GlobalTermMode::Exact, GlobalTermMode::Grid};
     o.model.spp = 8;
     o.model.block = 4;
+    o.model.frontierPathsPerCell = {4};
+    o.model.frontierSpp = {4};
     o.outDir = dir / "out";
     const SweepResult result = runSweep(o);
 
     // 1 reference + 3 rates × (1 exact + 2 grid + 2 approx) + 2 melanins × (1
-    // path reference + 2 modes + volumetric) + 2 + 2 + 2 scaling rows.
-    ASSERT_EQ(result.rows.size(), 30u);
+    // path reference + 2 modes + volumetric at its own and at one frontier
+    // budget + the path tracer at one frontier spp) + 2 + 2 + 2 scaling rows.
+    ASSERT_EQ(result.rows.size(), 34u);
     const auto csv = readCsv(o.outDir / "results.csv");
-    ASSERT_EQ(csv.size(), 31u);
+    ASSERT_EQ(csv.size(), 35u);
     ASSERT_EQ(csv[0].size(), kBenchCsvColumns.size());
     for (std::size_t i = 0; i < kBenchCsvColumns.size(); ++i)
         EXPECT_EQ(csv[0][i], kBenchCsvColumns[i]);
@@ -172,7 +177,11 @@ TEST(BenchSweep, TinySweepWritesTablesAndPlots) {
         EXPECT_EQ(!csv[r][column("rel_l1")].empty(), accuracy || model) << r;
         EXPECT_EQ(!csv[r][column("mae_v")].empty(), accuracy) << r;
         EXPECT_EQ(!csv[r][column("eumelanin")].empty(), model || pathReference) << r;
-        EXPECT_EQ(!csv[r][column("spp")].empty(), pathReference) << r;
+        const bool path = model && csv[r][column("mode")] == "path";
+        EXPECT_EQ(!csv[r][column("spp")].empty(), pathReference || path) << r;
+        EXPECT_EQ(!csv[r][column("paths_per_cell")].empty(), csv[r][column("mode")] == "volumetric")
+            << r;
+        EXPECT_EQ(csv[r][column("block")], accuracy || model ? "4" : "") << r;
         if (accuracy) {
             EXPECT_GE(std::stod(csv[r][column("rel_l1")]), 0.0);
             EXPECT_LT(std::stod(csv[r][column("rel_l1")]), 1.0);
@@ -185,14 +194,29 @@ TEST(BenchSweep, TinySweepWritesTablesAndPlots) {
             EXPECT_LE(std::stod(csv[r][column("block_rel_l1_noise_removed")]),
                       std::stod(csv[r][column("block_rel_l1")]))
                 << r;
-        } else {
+        } else if (!model) {
             EXPECT_EQ(csv[r][column("block_rel_l1")], "") << r;
         }
         if (model) {
-            // Against a noisy 8-spp reference: the floor is known and positive.
-            EXPECT_GT(std::stod(csv[r][column("noise_floor_l1")]), 0.0) << r;
-            EXPECT_LE(std::stod(csv[r][column("rel_l1_noise_removed")]),
-                      std::stod(csv[r][column("rel_l1")]))
+            // Against a noisy 8-spp reference: the floor is known and positive,
+            // per pixel and over blocks, and lower over blocks.
+            for (const char* prefix : {"", "block_"}) {
+                const auto at = [&](const char* name) {
+                    return std::stod(csv[r][column(std::string(prefix) + name)]);
+                };
+                EXPECT_GT(at("noise_floor_l1"), 0.0) << r << prefix;
+                EXPECT_LE(at("rel_l1_noise_removed"), at("rel_l1")) << r << prefix;
+            }
+            EXPECT_LT(std::stod(csv[r][column("block_noise_floor_l1")]),
+                      std::stod(csv[r][column("noise_floor_l1")]))
+                << r;
+        }
+        if (path) {
+            // The frontier's path tracer, at its own samples and seed: its raw
+            // error is its noise and the reference's, well above either floor.
+            EXPECT_EQ(csv[r][column("spp")], "4") << r;
+            EXPECT_GT(std::stod(csv[r][column("rel_l1")]),
+                      std::stod(csv[r][column("noise_floor_l1")]))
                 << r;
         }
         if (csv[r][column("sweep")] == "voxels") {
@@ -215,9 +239,11 @@ TEST(BenchSweep, TinySweepWritesTablesAndPlots) {
     ASSERT_EQ(result.fits.size(), 3u);
     EXPECT_EQ(result.fits[2].kind, BenchSweepKind::Voxels);
     // Halving the voxel size gives the tiny groom more active voxels (the fit's x).
-    const auto voxelsOf = [&](std::size_t r) { return std::stod(csv[r][column("active_voxels")]); };
-    EXPECT_GT(voxelsOf(30), voxelsOf(29));
-    EXPECT_NEAR(std::stod(csv[30][column("voxel_size")]), 0.012, 1e-6);
+    const auto voxelsOf = [&](std::size_t r) {
+        return std::stod(csv[r][column("active_voxels")]);
+    };
+    EXPECT_GT(voxelsOf(34), voxelsOf(33));
+    EXPECT_NEAR(std::stod(csv[34][column("voxel_size")]), 0.012, 1e-6);
     for (const ScalingFit& fit : result.fits) {
         ASSERT_TRUE(fit.total);
         ASSERT_TRUE(fit.prepare);
@@ -225,24 +251,43 @@ TEST(BenchSweep, TinySweepWritesTablesAndPlots) {
         EXPECT_FALSE(fit.peakMemory);
     }
 
+    // The host (bench/host): host.json's figures, and results.md's header names it.
+    std::ifstream hostFile(o.outDir / "host.json");
+    const nlohmann::json host = nlohmann::json::parse(hostFile);
+    EXPECT_EQ(host.at("simd_target").get<std::string>(), simdTarget());
+    EXPECT_FALSE(host.at("cpu_model").get<std::string>().empty());
+    EXPECT_GE(host.at("logical_cores").get<unsigned>(), 1u);
+    for (const char* key : {"simd_fma_flops_per_second", "dram_bytes_per_second",
+                            "miss_latency_ns", "baseline_flops_per_second"})
+        EXPECT_GT(host.at(key).get<double>(), 0.0) << key;
+    std::ifstream header(o.outDir / "results.md");
+    std::string line;
+    bool named = false;
+    while (std::getline(header, line) && !named)
+        named = line.rfind("Host: " + host.at("cpu_model").get<std::string>(), 0) == 0 &&
+                line.find("SIMD " + simdTarget()) != std::string::npos;
+    EXPECT_TRUE(named) << "results.md: no line \"Host: <cpu>, ..., SIMD <target>\"";
+
     std::ifstream md(o.outDir / "results.md");
     const std::string text((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
     for (const char* needle :
          {"## Summary", "| tiny | 3,300 | 64×64 |", "## tiny", "| exact K=2 (reference) |",
-          "4×4 blocks: noise removed | floor |",
-          "| grid x1 | 0.012 | vertex |", "## Scaling with segment count",
-          "## Scaling with image size", "cost ∝ pixels^k: total time k = ",
-          "## Scaling with active voxels", "| tiny 24 mm | 0.024 |",
-          "cost ∝ active voxels^k: total time k = ",
+          "4×4 blocks: noise removed | floor |", "| grid x1 | 0.012 | vertex |",
+          "## Scaling with segment count", "## Scaling with image size",
+          "cost ∝ pixels^k: total time k = ", "## Scaling with active voxels",
+          "| tiny 24 mm | 0.024 |", "cost ∝ active voxels^k: total time k = ",
           "## Model error: dual scattering and volumetric against path tracing",
-          "| tiny, dark | grid | ",
-          "| tiny, dark | volumetric | "})
+          "| tiny, dark | grid | ", "| tiny, dark | path 8 spp (reference) | ",
+          "| tiny, dark | volumetric 12 paths/cell | ", "| tiny, dark | volumetric 4 paths/cell | ",
+          "| tiny, dark | path 4 spp | "})
         EXPECT_NE(text.find(needle), std::string::npos) << needle << "\n" << text;
 
     // matplotlib figures (bench/sweep/plot_sweep.py): 14 × 6.5 in at 110 dpi (per pixel and
     // over blocks) and 3 × 7 × 5.2 in at 120 dpi (segments, pixels, active voxels).
     EXPECT_EQ(pngSize(o.outDir / "runtime_vs_error.png"), std::make_pair(1540u, 715u));
     EXPECT_EQ(pngSize(o.outDir / "scaling.png"), std::make_pair(2520u, 624u));
+    // The frontier: one scene (a row) × two hair colours (columns).
+    EXPECT_EQ(pngSize(o.outDir / "frontier.png"), std::make_pair(1040u, 440u));
     EXPECT_FALSE(std::filesystem::exists(o.outDir / ".work")) << "working files are removed";
 }
 
@@ -271,6 +316,12 @@ TEST(BenchSweep, BadInputIsAnInputError) {
     o = SweepOptions::quick(HAIRVOX_DATA_DIR "/scenes");
     o.validate();
     o.model.block = 0;
+    EXPECT_THROW(o.validate(), InputError);
+    o.model.block = 4;
+    o.model.frontierSpp = {o.model.spp}; // the path tracer below its reference's samples
+    EXPECT_THROW(o.validate(), InputError);
+    o.model.frontierSpp = {};
+    o.model.frontierPathsPerCell = {0.0f};
     EXPECT_THROW(o.validate(), InputError);
     BenchScene s = sceneFile("x", "some.json");
     s.style = GroomStyle::Curly;

@@ -103,7 +103,6 @@ BenchScene sceneFromJson(const json& j) {
     return s;
 }
 
-
 std::optional<double> optionalFromJson(const json& j) {
     return j.is_null() ? std::nullopt : std::optional<double>(j.get<double>());
 }
@@ -188,6 +187,8 @@ json jobToJson(const BenchJob& job) {
             {"voxel_scale", job.config.voxelScale},
             {"rays", job.config.rays},
             {"shading_rate", toString(job.config.shadingRate)},
+            {"paths_per_cell", job.config.pathsPerCell},
+            {"config_spp", job.config.spp},
             {"voxel_size", job.voxelSize},
             {"runs", job.runs},
             {"single_run_above", job.singleRunAbove},
@@ -212,12 +213,13 @@ BenchJob jobFromJson(const json& j) {
     job.block = j.at("block").get<int>();
     job.scene = sceneFromJson(j.at("scene"));
     job.config.mode = kGlobalTermModeNames.parse(j.at("mode").get<std::string>()).value();
-    job.config.integrator =
-        kIntegratorNames.parse(j.at("integrator").get<std::string>()).value();
+    job.config.integrator = kIntegratorNames.parse(j.at("integrator").get<std::string>()).value();
     job.config.voxelScale = j.at("voxel_scale").get<double>();
     job.config.rays = j.at("rays").get<std::uint32_t>();
     job.config.shadingRate =
         kShadingRateNames.parse(j.at("shading_rate").get<std::string>()).value();
+    job.config.pathsPerCell = j.at("paths_per_cell").get<float>();
+    job.config.spp = j.at("config_spp").get<std::uint32_t>();
     job.voxelSize = j.at("voxel_size").get<double>();
     job.runs = j.at("runs").get<int>();
     job.singleRunAbove = j.at("single_run_above").get<double>();

@@ -47,7 +47,7 @@ PlotResult drawPlots(const std::filesystem::path& outDir, const std::filesystem:
                                 " failed (its message is above; is python3-matplotlib installed?)");
         return result;
     }
-    for (const char* name : {"runtime_vs_error.png", "scaling.png"}) {
+    for (const char* name : {"runtime_vs_error.png", "scaling.png", "frontier.png"}) {
         const std::filesystem::path p = outDir / name;
         if (std::filesystem::exists(p))
             result.written.push_back(p);

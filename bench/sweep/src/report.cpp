@@ -5,29 +5,18 @@
 #include <hairvox/core/error.h>
 #include <hairvox/core/format.h>
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <ctime>
 #include <fstream>
 #include <functional>
-#include <thread>
 
 namespace hairvox::bench {
 
 namespace {
-
-std::string cpuModel() {
-    std::ifstream in("/proc/cpuinfo");
-    std::string line;
-    while (std::getline(in, line))
-        if (line.rfind("model name", 0) == 0) {
-            const std::size_t colon = line.find(':');
-            if (colon != std::string::npos)
-                return line.substr(line.find_first_not_of(' ', colon + 1));
-        }
-    return "unknown CPU";
-}
 
 std::string utcNow() {
     const std::time_t now = std::time(nullptr);
@@ -88,37 +77,55 @@ std::string fitText(const char* what, const std::optional<PowerLawFit>& f) {
     return strCat(what, " k = ", format("%.2f", f->exponent), " (R² ", format("%.3f", f->r2), ")");
 }
 
-/// The model sweep's table: one row per scene, hair colour and mode.
+/// "~0.0123": the error with the reference's noise removed, marked when it is
+/// within 1.5× that noise (not resolved); "–" when not measured.
+std::string removedText(const std::optional<ImageError>& e) {
+    if (!e)
+        return "–";
+    return strCat(e->resolved() ? "" : "~", format("%.4f", e->relL1NoiseRemoved));
+}
+
+/// The model sweep's table: per scene and hair colour, the path-traced
+/// reference, then one row per method (dual scattering's modes, the volumetric
+/// integrator at its budgets, the path tracer at fewer samples).
 std::string modelMarkdown(const SweepOptions& o, const std::vector<BenchRow>& rows) {
     const std::vector<std::string> scenes = sceneOrder(rows, BenchSweepKind::PathReference);
     if (scenes.empty())
         return {};
     std::string md = "## Model error: dual scattering and volumetric against path tracing\n\n";
     md += strCat(
-        "The hair's radiance (the beauty without head and background) of each global-term mode "
-        "and of the volumetric integrator (docs/DESIGN.md §9) against a path trace of the same fibers with the same f_s (docs/DESIGN.md §8), "
-        "compared as means over ",
+        "The hair's radiance (the beauty without head and background) of each global-term mode, "
+        "of the volumetric integrator (docs/DESIGN.md §9) at its budgets and of the path tracer "
+        "at fewer samples (seeded apart from the reference) against a path trace of the same "
+        "fibers with the same f_s (docs/DESIGN.md §8), per pixel and as means over ",
         o.model.block, "×", o.model.block,
         " pixel blocks. `floor`: the relative L1 the reference's own noise gives (from its "
         "two independent halves); `noise removed`: sqrt(L1² − floor²) — an error within 1.5× "
-        "its floor is not resolved (marked ~). `bias`: signed, the estimate brighter when "
-        "positive. Target: within 0.05 with the noise removed.\n\n");
-    md += "| scene, hair | method | rel L1 | floor | noise removed | bias | s | reference s | "
-          "spp | Mrays/s | Mpaths/s |\n";
-    md += "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+        "its floor is not resolved (marked ~). `bias`: signed, over the blocks, the estimate "
+        "brighter when positive. Target: within 0.05 over the blocks with the noise removed. "
+        "frontier.png plots time against both errors.\n\n");
+    md += "| scene, hair | method | s | pixels: rel L1 | floor | noise removed | blocks: rel L1 "
+          "| floor | noise removed | bias | spp | Mrays/s | Mpaths/s |\n";
+    md += "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     for (const std::string& s : scenes) {
-        const BenchRow* ref = findRow(
-            rows, s, [](const BenchRow& r) { return r.kind == BenchSweepKind::PathReference; });
         for (const BenchRow& r : rows) {
-            if (r.scene != s || r.kind != BenchSweepKind::Model || !r.m.image)
+            if (r.scene != s ||
+                (r.kind != BenchSweepKind::Model && r.kind != BenchSweepKind::PathReference))
                 continue;
-            const ImageError& e = *r.m.image;
-            const PathTraceStats* pt = ref && ref->m.pathTrace ? &*ref->m.pathTrace : nullptr;
-            md += strCat("| ", s, " | ", r.config.method(), " | ", format("%.4f", e.relL1),
-                         " | ", format("%.4f", e.noiseFloorL1), " | ", e.resolved() ? "" : "~",
-                         format("%.4f", e.relL1NoiseRemoved), " | ", format("%+.4f", e.relBias),
-                         " | ", seconds(r.m.totalSeconds), " | ",
-                         ref ? seconds(ref->m.totalSeconds) : "–", " | ",
+            const bool reference = r.kind == BenchSweepKind::PathReference;
+            const PathTraceStats* pt = r.m.pathTrace ? &*r.m.pathTrace : nullptr;
+            const auto errors = [](const std::optional<ImageError>& e) {
+                return e ? strCat(format("%.4f", e->relL1), " | ", format("%.4f", e->noiseFloorL1),
+                                  " | ", removedText(e))
+                         : std::string("– | – | –");
+            };
+            md += strCat("| ", s, " | ",
+                         reference ? strCat("path ", pt ? pt->spp : 0u, " spp (reference)")
+                         : r.config.integrator == Integrator::DualScattering ? r.config.method()
+                                                                             : r.config.label(),
+                         " | ", seconds(r.m.totalSeconds), " | ", errors(r.m.image), " | ",
+                         errors(r.m.imageBlocks), " | ",
+                         r.m.imageBlocks ? format("%+.4f", r.m.imageBlocks->relBias) : "–", " | ",
                          pt ? std::to_string(pt->spp) : "–", " | ",
                          pt ? format("%.2f", pt->raysPerSecond() * 1e-6) : "–", " | ",
                          pt ? format("%.3f", pt->pathsPerSecond() * 1e-6) : "–", " |\n");
@@ -132,10 +139,28 @@ std::string modelMarkdown(const SweepOptions& o, const std::vector<BenchRow>& ro
 RunInfo RunInfo::now() {
     RunInfo info;
     info.started = utcNow();
-    info.cpu = cpuModel();
-    info.cores = std::thread::hardware_concurrency();
-    info.loadStart = info.loadMax = loadAverage();
+    info.loadStart = info.loadMax = loadAverage(); // before the calibration's own load
+    info.host = HostReport::measure();
     return info;
+}
+
+std::string hostJsonText(const RunInfo& info) {
+    const HostReport& h = info.host;
+    const MachineCalibration& c = h.calibration;
+    const nlohmann::ordered_json j = {
+        {"cpu_model", h.host.cpuModel},
+        {"logical_cores", h.host.logicalCores},
+        {"simd_target", h.simdTarget},
+        {"simd_fma_flops_per_second", h.simdFmaFlopsPerSecond},
+        {"dram_bytes_per_second", c.dramBytesPerSecond},
+        {"miss_latency_ns", c.missLatencyNs},
+        {"baseline_flops_per_second", c.baselineFlopsPerSecond},
+        {"calibration_array_bytes", c.arrayBytes},
+        {"calibration_seconds", c.seconds},
+        {"started", info.started},
+        {"load_average",
+         {{"start", info.loadStart}, {"max", info.loadMax}, {"end", info.loadEnd}}}};
+    return j.dump(2) + "\n";
 }
 
 double loadAverage() {
@@ -189,7 +214,9 @@ std::string csvText(const std::vector<BenchRow>& rows) {
             csvOptional(m.imageBlocks ? std::optional(m.imageBlocks->noiseFloorL1) : std::nullopt),
             csvOptional(m.imageBlocks ? std::optional(m.imageBlocks->relL1NoiseRemoved)
                                       : std::nullopt),
-            csvNumber(m.prepareSeconds)};
+            csvNumber(m.prepareSeconds),
+            r.config.integrator == Integrator::Volumetric ? csvNumber(r.config.pathsPerCell) : "",
+            r.block > 0 ? std::to_string(r.block) : ""};
         for (std::size_t i = 0; i < cells.size(); ++i) {
             // Scene labels are the only free text: quote them if they need it.
             const bool quote = cells[i].find_first_of(",\"\n") != std::string::npos;
@@ -222,8 +249,8 @@ std::string markdownText(const SweepOptions& o, const SweepResult& result, const
     std::string md = "# hairvox benchmark: run time against error, and how cost grows\n\n";
     md += strCat(
         "Generated by `", o.commandLine.empty() ? std::string("hairvox bench") : o.commandLine,
-        "`, started ", info.started, ", on ", info.cpu, " (", info.cores,
-        " hardware threads), load average (1 min) ", format("%.1f", info.loadStart),
+        "`, started ", info.started, ".\n\nHost: ", info.host.line(),
+        "; in host.json.\n\nLoad average (1 min) ", format("%.1f", info.loadStart),
         " at the start, at most ", format("%.1f", info.loadMax), ", ", format("%.1f", info.loadEnd),
         " at the end (the machine may be shared: times are wall clock).\n\n");
     md += strCat("Times are seconds, end to end through `renderScene()` including writing the EXR "
@@ -248,8 +275,10 @@ std::string markdownText(const SweepOptions& o, const SweepResult& result, const
                  "alone gives (`floor`) is measured from them and removed from every error "
                  "(`noise removed` = sqrt(L1² − floor²), film/image_compare.h); an error within "
                  "1.5× the floor is not resolved and is marked ~. The same errors over the means "
-                 "of ", kAccuracyBlock, "×", kAccuracyBlock, " pixel blocks (`", kAccuracyBlock,
-                 "×", kAccuracyBlock, " blocks`), where the reference's per-pixel noise averages "
+                 "of ",
+                 kAccuracyBlock, "×", kAccuracyBlock, " pixel blocks (`", kAccuracyBlock, "×",
+                 kAccuracyBlock,
+                 " blocks`), where the reference's per-pixel noise averages "
                  "out and an error that is there at that scale does not, resolve what the pixels "
                  "cannot.\n\n");
 
@@ -262,10 +291,11 @@ std::string markdownText(const SweepOptions& o, const SweepResult& result, const
         md += strCat(
             "| scene | segments | image | h0 | exact reference s | exact K=", fewestRays,
             " s | grid x1 s | grid speed-up: global term, total | grid x1 rel L1 | "
-            "noise removed | floor | ", kAccuracyBlock, "×", kAccuracyBlock,
+            "noise removed | floor | ",
+            kAccuracyBlock, "×", kAccuracyBlock,
             " blocks: noise removed | floor | MAE(V) | MAE(T_s) | approx within grid's time | "
-            "its rel L1 | noise removed | ", kAccuracyBlock, "×", kAccuracyBlock,
-            " blocks |\n");
+            "its rel L1 | noise removed | ",
+            kAccuracyBlock, "×", kAccuracyBlock, " blocks |\n");
         md += "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|"
               "---:|---:|\n";
         for (const std::string& s : scenes) {
@@ -296,11 +326,6 @@ std::string markdownText(const SweepOptions& o, const SweepResult& result, const
                 line += "–";
             const auto relL1 = [](const BenchRow* r) {
                 return r && r->m.image ? std::optional(r->m.image->relL1) : std::nullopt;
-            };
-            const auto removedText = [](const std::optional<ImageError>& e) {
-                if (!e)
-                    return std::string("–");
-                return strCat(e->resolved() ? "" : "~", format("%.4f", e->relL1NoiseRemoved));
             };
             const auto removed = [&](const BenchRow* r) {
                 return r ? removedText(r->m.image) : std::string("–");
@@ -376,8 +401,7 @@ std::string markdownText(const SweepOptions& o, const SweepResult& result, const
                 m.imageBlocks ? strCat(m.imageBlocks->resolved() ? "" : "~",
                                        format("%.4f", m.imageBlocks->relL1NoiseRemoved))
                               : std::string("–"),
-                " | ",
-                mdOptional(m.probe ? std::optional(m.probe->maeV) : std::nullopt, 4), " | ",
+                " | ", mdOptional(m.probe ? std::optional(m.probe->maeV) : std::nullopt, 4), " | ",
                 mdOptional(m.probe ? std::optional(m.probe->maeT_s) : std::nullopt, 4), " |\n");
         }
         md += "\n";
@@ -408,18 +432,18 @@ std::string markdownText(const SweepOptions& o, const SweepResult& result, const
                 continue;
             if (kind == BenchSweepKind::Voxels)
                 md += strCat("| ", r.scene, " | ", format("%.3g", r.m.voxelSize), " | ",
-                             thousands(r.m.activeVoxels), " | ", seconds(r.m.prepareSeconds),
-                             " |", stageCells(r.m), "\n");
+                             thousands(r.m.activeVoxels), " | ", seconds(r.m.prepareSeconds), " |",
+                             stageCells(r.m), "\n");
             else
                 md += strCat("| ", r.scene, " | ", thousands(r.m.segments), " | ", imageSize(r),
                              " |", stageCells(r.m), "\n");
         }
-        md += strCat("\nGrowth, least-squares fit of cost ∝ ", x,
-                     "^k: ", fitText("total time", fit.total), "; ",
-                     fitText("voxelize", fit.voxelize), "; ", fitText("global term", fit.globalTerm),
-                     "; ", fitText("of it the lights' preparation", fit.prepare), "; ",
-                     fitText("raster + shade", fit.rasterShade), "; ",
-                     fitText("peak memory", fit.peakMemory), ".\n\n");
+        md += strCat(
+            "\nGrowth, least-squares fit of cost ∝ ", x, "^k: ", fitText("total time", fit.total),
+            "; ", fitText("voxelize", fit.voxelize), "; ", fitText("global term", fit.globalTerm),
+            "; ", fitText("of it the lights' preparation", fit.prepare), "; ",
+            fitText("raster + shade", fit.rasterShade), "; ",
+            fitText("peak memory", fit.peakMemory), ".\n\n");
     }
     return md;
 }

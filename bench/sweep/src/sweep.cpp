@@ -42,7 +42,7 @@ private:
     std::filesystem::path path_;
 };
 
-/// Writes results.csv, results.md, scaling_fits.csv and the plots.
+/// Writes results.csv, results.md, scaling_fits.csv, host.json and the plots.
 std::vector<std::filesystem::path> writeSweepOutputs(const SweepOptions& o, SweepResult& result,
                                                      const RunInfo& info,
                                                      const std::filesystem::path& workDir) {
@@ -55,6 +55,7 @@ std::vector<std::filesystem::path> writeSweepOutputs(const SweepOptions& o, Swee
     writeText(o.outDir / "results.csv", csvText(result.rows));
     writeText(o.outDir / "results.md", markdownText(o, result, info));
     writeText(o.outDir / "scaling_fits.csv", fitsCsvText(result.fits));
+    writeText(o.outDir / "host.json", hostJsonText(info));
     const PlotResult plots = drawPlots(o.outDir, workDir);
     if (!plots.problem.empty() && o.log)
         *o.log << "bench: warning: no plots drawn: " << plots.problem << std::endl;
@@ -105,12 +106,15 @@ BenchScene BenchScene::atWidth(std::uint32_t w) const {
 }
 
 std::string BenchConfig::method() const {
-    return integrator == Integrator::Volumetric ? toString(integrator) : toString(mode);
+    return integrator == Integrator::DualScattering ? toString(mode) : toString(integrator);
 }
 
 std::string BenchConfig::label() const {
     if (integrator == Integrator::Volumetric)
-        return method();
+        return pathsPerCell > 0 ? strCat(method(), " ", scaleText(pathsPerCell), " paths/cell")
+                                : method();
+    if (integrator == Integrator::Path)
+        return strCat(method(), " ", spp, " spp");
     if (mode == GlobalTermMode::Exact)
         return strCat("exact K=", rays);
     return strCat(toString(mode), " x", scaleText(voxelScale));
@@ -214,8 +218,12 @@ SweepOptions SweepOptions::full(const std::filesystem::path& scenesDir) {
     BenchScene bear;
     bear.label = "TressFX bear";
     bear.file = scenesDir / "bear.json";
-    o.scenes = {style("straight", GroomStyle::Straight), wavy, style("curly", GroomStyle::Curly),
-                ratboy, bear, head};
+    o.scenes = {style("straight", GroomStyle::Straight),
+                wavy,
+                style("curly", GroomStyle::Curly),
+                ratboy,
+                bear,
+                head};
     o.voxelScales = {4, 2, 1.4, 1, 0.7};
     o.exactRays = {1, 4};
     o.referenceRays = 16;
@@ -232,11 +240,14 @@ SweepOptions SweepOptions::full(const std::filesystem::path& scenesDir) {
         s.width = s.height = size;
         o.pixelScaling.push_back(s);
     }
-    o.voxelScaling = voxelScenes(std::filesystem::exists(ratboy.file) ? ratboy.atWidth(1280) : ratboy,
-                                 {0.002, 0.001, 0.0007, 0.0005});
+    o.voxelScaling =
+        voxelScenes(std::filesystem::exists(ratboy.file) ? ratboy.atWidth(1280) : ratboy,
+                    {0.002, 0.001, 0.0007, 0.0005});
     o.model.scenes = modelScenes(scenesDir, 256, true);
-    o.model.spp = 256;
+    o.model.spp = 1024;
     o.model.block = 8;
+    o.model.frontierPathsPerCell = {3, 48};
+    o.model.frontierSpp = {4, 16, 64, 256};
     return o;
 }
 
@@ -273,12 +284,20 @@ SweepOptions SweepOptions::quick(const std::filesystem::path& scenesDir) {
     BenchScene ratboy;
     ratboy.label = "Ratboy mohawk";
     ratboy.file = scenesDir / "ratboy_mohawk.json";
-    o.voxelScaling = voxelScenes(std::filesystem::exists(ratboy.file) ? ratboy.atWidth(640) : ratboy,
-                                 {0.002, 0.001, 0.0005});
+    o.voxelScaling =
+        voxelScenes(std::filesystem::exists(ratboy.file) ? ratboy.atWidth(640) : ratboy,
+                    {0.002, 0.001, 0.0005});
     o.model.scenes = modelScenes(scenesDir, 128, false);
     o.model.spp = 64;
     o.model.block = 4;
+    o.model.frontierPathsPerCell = {4};
+    o.model.frontierSpp = {4, 16};
     return o;
+}
+
+std::size_t ModelSweepOptions::jobsPerCell() const {
+    return 1 + modes.size() + (volumetric ? 1 : 0) + frontierPathsPerCell.size() +
+           frontierSpp.size();
 }
 
 void SweepOptions::validate() const {
@@ -331,6 +350,15 @@ void SweepOptions::validate() const {
             throw InputError(strCat("bench: model time limit ", model.timeLimit, " should be ≥ 0"));
         if (model.block < 1 || model.block > 64)
             throw InputError(strCat("bench: model block ", model.block, " outside [1, 64]"));
+        for (const float n : model.frontierPathsPerCell)
+            if (!(n > 0 && n <= 1e4f))
+                throw InputError(
+                    strCat("bench: frontier paths per cell ", n, " outside (0, 10^4]"));
+        for (const std::uint32_t n : model.frontierSpp)
+            if (n < 2 || n >= model.spp)
+                throw InputError(strCat("bench: frontier spp ", n, " outside [2, ", model.spp,
+                                        "): the path tracer is measured against a reference of ",
+                                        model.spp, " spp"));
     }
 }
 
@@ -362,8 +390,7 @@ SweepResult runSweep(const SweepOptions& o) {
     const std::size_t jobCount =
         o.scenes.size() * perScene + o.segmentScaling.size() + o.pixelScaling.size() +
         o.voxelScaling.size() +
-        o.model.scenes.size() * o.model.melanins.size() *
-        (1 + o.model.modes.size() + (o.model.volumetric ? 1 : 0));
+        o.model.scenes.size() * o.model.melanins.size() * o.model.jobsPerCell();
     std::size_t jobIndex = 0;
     const auto start = Clock::now();
 
@@ -395,8 +422,13 @@ SweepResult runSweep(const SweepOptions& o) {
         row.eumelanin = job.scene.eumelanin;
         row.config = job.config;
         const Scene scene = job.scene.build();
+        if (row.config.integrator == Integrator::Volumetric && row.config.pathsPerCell == 0)
+            row.config.pathsPerCell = scene.volumetric.pathsPerCell; // the budget it ran at
         row.width = scene.camera.width;
         row.height = scene.camera.height;
+        row.block = kind == BenchSweepKind::Accuracy ? kAccuracyBlock
+                    : kind == BenchSweepKind::Model  ? job.block
+                                                     : 0;
         row.m = measurementFromJson(readJsonFile(job.result));
         if (o.log) {
             const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
@@ -487,22 +519,29 @@ SweepResult runSweep(const SweepOptions& o) {
             ref.timeLimit = o.model.timeLimit;
             ref.referenceImage = work.path() / strCat("model-", si, "-", mi, "-reference.bin");
             run(ref, BenchSweepKind::PathReference);
-            for (const GlobalTermMode mode : o.model.modes) {
+            const auto measure = [&](BenchConfig config) {
                 BenchJob job;
                 job.scene = scene;
-                job.config = {mode, 1.0, 1, ShadingRate::Fragment};
+                job.config = config;
                 job.referenceImage = ref.referenceImage;
                 job.block = o.model.block;
                 run(job, BenchSweepKind::Model);
+            };
+            for (const GlobalTermMode mode : o.model.modes)
+                measure({mode, 1.0, 1, ShadingRate::Fragment});
+            BenchConfig volumetric{GlobalTermMode::Grid, 1.0, 1, ShadingRate::Fragment,
+                                   Integrator::Volumetric};
+            if (o.model.volumetric)
+                measure(volumetric);
+            for (const float n : o.model.frontierPathsPerCell) {
+                volumetric.pathsPerCell = n;
+                measure(volumetric);
             }
-            if (o.model.volumetric) {
-                BenchJob job;
-                job.scene = scene;
-                job.config = {GlobalTermMode::Grid, 1.0, 1, ShadingRate::Fragment,
-                              Integrator::Volumetric};
-                job.referenceImage = ref.referenceImage;
-                job.block = o.model.block;
-                run(job, BenchSweepKind::Model);
+            for (const std::uint32_t n : o.model.frontierSpp) {
+                BenchConfig path{GlobalTermMode::Grid, 1.0, 1, ShadingRate::Fragment,
+                                 Integrator::Path};
+                path.spp = n;
+                measure(path);
             }
         }
         info.loadEnd = loadAverage();

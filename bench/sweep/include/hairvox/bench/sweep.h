@@ -44,11 +44,15 @@
 // rendered with dual scattering in each global-term mode and with the
 // volumetric integrator (docs/DESIGN.md §9). The hair's radiance
 // (pipeline's hairRadianceOf: the beauty without head and background) is
-// compared as means over block × block pixels, where the rasterizer's point
-// sampling and the path tracer's per-pixel noise average out but a bias does
-// not: relative L1 raw, the reference's noise floor, the L1 with the noise
-// removed (film/image_compare.h) and the signed bias; with the reference's
-// time, samples, rays/s and paths/s.
+// compared per pixel and as means over block × block pixels, where the
+// rasterizer's point sampling and the path tracer's per-pixel noise average
+// out but a bias does not: relative L1 raw, the reference's noise floor, the
+// L1 with the noise removed (film/image_compare.h) and the signed bias; with
+// the reference's time, samples, rays/s and paths/s. The time-against-error
+// frontier adds the volumetric integrator at other budgets (paths per cell)
+// and the path tracer itself at fewer samples than the reference, seeded
+// apart from it: its error with the reference's noise removed is its own
+// noise, so every method is read on one axis — what a time budget buys.
 //
 // Isolation: with a worker command (the CLI passes `hairvox bench --one`),
 // every job runs in its own child process, so its peak resident memory is
@@ -58,10 +62,14 @@
 //
 // Outputs in SweepOptions::outDir, rewritten after each scene:
 //   results.csv            one row per measured configuration (kBenchCsvColumns)
+//   host.json              the machine (bench/host: CPU, cores, SIMD target, calibration)
 //   results.md             the tables: summary, per scene, scaling with exponents
 //   scaling_fits.csv       the fitted growth exponents
 //   runtime_vs_error.png   total time against image error, one curve (the
 //                          Pareto front) per scene, points labelled (matplotlib)
+//   frontier.png           the model sweep's time against error per scene and
+//                          hair colour: dual scattering, volumetric over its
+//                          budgets and path tracing over its samples
 //   scaling.png            time against segment count, pixel count and active voxels
 #pragma once
 
@@ -113,13 +121,18 @@ struct BenchConfig {
     double voxelScale = 1;
     std::uint32_t rays = 1; ///< exact: rays per shading point
     ShadingRate shadingRate = ShadingRate::Fragment;
-    /// Dual scattering (the mode above) or volumetric (the model sweep: its
-    /// single scattering in grid mode, its multiple scattering solved on the grid).
+    /// Dual scattering (the mode above), volumetric (the model sweep: its
+    /// single scattering in grid mode, its multiple scattering solved on the
+    /// grid) or path tracing (the model sweep's time-against-error frontier).
     Integrator integrator = Integrator::DualScattering;
+    /// Volumetric: its budget, light paths per cache cell; 0: the scene's.
+    float pathsPerCell = 0;
+    /// Path tracing: samples per pixel, with another seed than the reference's.
+    std::uint32_t spp = 0;
 
-    /// "grid x1.4", "exact K=4", "volumetric".
+    /// "grid x1.4", "exact K=4", "volumetric", "volumetric 4 paths/cell", "path 16 spp".
     std::string label() const;
-    /// The mode's name, or "volumetric" (the model sweep's and the CSV's "mode").
+    /// The mode's name, or the integrator's (the CSV's "mode").
     std::string method() const;
 };
 
@@ -189,6 +202,7 @@ struct BenchRow {
     std::optional<float> eumelanin; ///< BenchScene::eumelanin
     BenchConfig config;
     std::uint32_t width = 0, height = 0;
+    int block = 0; ///< side in pixels of the blocks of m.imageBlocks; 0: none
     BenchMeasurement m;
 };
 
@@ -198,20 +212,45 @@ struct ScalingFit {
     std::optional<PowerLawFit> total, voxelize, globalTerm, prepare, rasterShade, peakMemory;
 };
 
-inline constexpr std::array<const char*, 37> kBenchCsvColumns = {
-    "sweep",         "scene",          "mode",
-    "voxel_scale",   "voxel_size",     "rays",
-    "shading_rate",  "width",          "height",
-    "segments",      "runs",           "load_s",
-    "voxelize_s",    "tables_s",       "global_term_s",
-    "raster_s",      "shade_s",        "write_s",
-    "total_s",       "peak_mib",       "shading_points",
-    "active_voxels", "rel_l1",         "rel_rmse",
-    "mae_v",         "mae_ts",         "eumelanin",
-    "rel_bias",      "noise_floor_l1", "rel_l1_noise_removed",
-    "spp",           "rays_per_s",     "paths_per_s",
-    "block_rel_l1",  "block_noise_floor_l1", "block_rel_l1_noise_removed",
-    "global_term_prepare_s"};
+inline constexpr std::array<const char*, 39> kBenchCsvColumns = {"sweep",
+                                                                 "scene",
+                                                                 "mode",
+                                                                 "voxel_scale",
+                                                                 "voxel_size",
+                                                                 "rays",
+                                                                 "shading_rate",
+                                                                 "width",
+                                                                 "height",
+                                                                 "segments",
+                                                                 "runs",
+                                                                 "load_s",
+                                                                 "voxelize_s",
+                                                                 "tables_s",
+                                                                 "global_term_s",
+                                                                 "raster_s",
+                                                                 "shade_s",
+                                                                 "write_s",
+                                                                 "total_s",
+                                                                 "peak_mib",
+                                                                 "shading_points",
+                                                                 "active_voxels",
+                                                                 "rel_l1",
+                                                                 "rel_rmse",
+                                                                 "mae_v",
+                                                                 "mae_ts",
+                                                                 "eumelanin",
+                                                                 "rel_bias",
+                                                                 "noise_floor_l1",
+                                                                 "rel_l1_noise_removed",
+                                                                 "spp",
+                                                                 "rays_per_s",
+                                                                 "paths_per_s",
+                                                                 "block_rel_l1",
+                                                                 "block_noise_floor_l1",
+                                                                 "block_rel_l1_noise_removed",
+                                                                 "global_term_prepare_s",
+                                                                 "paths_per_cell",
+                                                                 "block"};
 
 /// The model sweep (see the file comment).
 struct ModelSweepOptions {
@@ -223,9 +262,18 @@ struct ModelSweepOptions {
                                       GlobalTermMode::Approx};
     /// The volumetric integrator in every cell too, beside dual scattering.
     bool volumetric = true;
+    /// The time-against-error frontier: the volumetric integrator at these
+    /// budgets too (paths per cell, (0, 10^4]; its default budget is the row
+    /// above), and the path tracer at these samples per pixel (each below
+    /// `spp`, seeded apart from the reference, so its error is its own noise).
+    std::vector<float> frontierPathsPerCell;
+    std::vector<std::uint32_t> frontierSpp;
     std::uint32_t spp = 256; ///< of each path-traced reference, [2, 10^6]
     double timeLimit = 0;    ///< seconds per reference, 0: none; the first of spp and this stops it
     int block = 8;           ///< side in pixels of the compared blocks, [1, 64]
+
+    /// Jobs per scene and hair colour: the reference and each method.
+    std::size_t jobsPerCell() const;
 };
 
 struct SweepOptions {
@@ -261,14 +309,17 @@ struct SweepOptions {
     /// with 1 and 4 rays against 16; scaling 10k–1.4M segments at 1920×1080,
     /// 256²–2048², and Ratboy at 1280² from 2 mm to 0.5 mm voxels; the model
     /// sweep on the default scene, the curly close-up and Ratboy at 256² (the
-    /// scenes' aspect), blond, medium and dark, 256 spp, 8 × 8 blocks.
+    /// scenes' aspect), blond, medium and dark, 1024 spp, 8 × 8 blocks, its
+    /// frontier with volumetric at 3 and 48 paths per cell and path tracing
+    /// at 4, 16, 64 and 256 spp.
     static SweepOptions full(const std::filesystem::path& scenesDir);
     /// A representative subset in 3–7 minutes on 2 cores: wavy and curly
     /// at 512², voxel sizes ×4, ×2, ×1, exact with 1 ray against 4, fragment
     /// shading, one run per configuration; scaling 10k–400k segments at
     /// 960×540, 256²–1024², and Ratboy at 640² at 2, 1 and 0.5 mm voxels;
     /// the model sweep on the default scene and the curly close-up at 128²,
-    /// 64 spp, 4 × 4 blocks.
+    /// 64 spp, 4 × 4 blocks, its frontier with volumetric at 4 paths per
+    /// cell and path tracing at 4 and 16 spp.
     static SweepOptions quick(const std::filesystem::path& scenesDir);
 
     void validate() const;
