@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <memory>
 #include <new>
 #include <limits>
@@ -32,26 +33,70 @@ int valueIndex(int x, int y, int z) {
     return (x * BrickVolume::kSide + y) * BrickVolume::kSide + z;
 }
 
+/// Half of a Lanes value in a SIMD register (GCC's and Clang's vector
+/// extension: SSE on x86-64's baseline, the same elementwise arithmetic in
+/// the same order as on floats, so the same bits). Loops over the 8 floats
+/// kept their sums in memory between corners.
+using Half = float __attribute__((vector_size(16)));
+
+inline Half loadHalf(const Lanes& v, int h) {
+    Half r;
+    std::memcpy(&r, v.v + 4 * h, sizeof(r));
+    return r;
+}
+
+inline void storeHalf(Lanes& v, int h, const Half& r) { std::memcpy(v.v + 4 * h, &r, sizeof(r)); }
+
 /// Trilinear interpolation of a cell's corners at fractions f. The corners
 /// left out are zero, so the sum is the 8-corner sum, bit for bit (adding
 /// w·0 to a non-negative sum leaves it as it is).
 inline Lanes trilinear(const CellCorners& c, const Vec3f& f) {
     const float wx[2] = {1.0f - f.x, f.x}, wy[2] = {1.0f - f.y, f.y}, wz[2] = {1.0f - f.z, f.z};
-    Lanes r;
+    Half r0 = {}, r1 = {};
     for (int i = 0; i < c.count; ++i) {
         const int k = c.k[std::size_t(i)];
         const float w = wx[k >> 2] * wy[(k >> 1) & 1] * wz[k & 1];
         const Lanes& v = *c.value[std::size_t(i)];
-        for (int lane = 0; lane < 8; ++lane)
-            r.v[lane] += w * v.v[lane];
+        r0 += w * loadHalf(v, 0);
+        r1 += w * loadHalf(v, 1);
     }
+    Lanes r;
+    storeHalf(r, 0, r0);
+    storeHalf(r, 1, r1);
     return r;
+}
+
+/// trilinear() at fractions f and g together (a piece's middle and end): the
+/// same sums in the same order, as two independent chains of additions
+/// where one evaluation after the other waited on each add's latency.
+inline void trilinear2(const CellCorners& c, const Vec3f& f, const Vec3f& g, Lanes& atF,
+                       Lanes& atG) {
+    const float fx[2] = {1.0f - f.x, f.x}, fy[2] = {1.0f - f.y, f.y}, fz[2] = {1.0f - f.z, f.z};
+    const float gx[2] = {1.0f - g.x, g.x}, gy[2] = {1.0f - g.y, g.y}, gz[2] = {1.0f - g.z, g.z};
+    Half f0 = {}, f1 = {}, g0 = {}, g1 = {};
+    for (int i = 0; i < c.count; ++i) {
+        const int k = c.k[std::size_t(i)];
+        const float wf = fx[k >> 2] * fy[(k >> 1) & 1] * fz[k & 1];
+        const float wg = gx[k >> 2] * gy[(k >> 1) & 1] * gz[k & 1];
+        const Lanes& v = *c.value[std::size_t(i)];
+        const Half v0 = loadHalf(v, 0), v1 = loadHalf(v, 1);
+        f0 += wf * v0;
+        f1 += wf * v1;
+        g0 += wg * v0;
+        g1 += wg * v1;
+    }
+    storeHalf(atF, 0, f0);
+    storeHalf(atF, 1, f1);
+    storeHalf(atG, 0, g0);
+    storeHalf(atG, 1, g1);
 }
 
 /// a += w·(f0 + 4 fm + f1), lane by lane.
 inline void addSimpson(Lanes& a, const Lanes& f0, const Lanes& fm, const Lanes& f1, float w) {
-    for (int lane = 0; lane < 8; ++lane)
-        a.v[lane] += w * (f0.v[lane] + 4.0f * fm.v[lane] + f1.v[lane]);
+    for (int h = 0; h < 2; ++h)
+        storeHalf(a, h,
+                  loadHalf(a, h) +
+                      w * (loadHalf(f0, h) + 4.0f * loadHalf(fm, h) + loadHalf(f1, h)));
 }
 
 /// Bit of cell c in a bitmap of the box [lo, hi] (x fastest).
@@ -314,14 +359,31 @@ void BrickVolume::set(const BrickSet& bricks, const glm::ivec3& local, const Opt
 
 CellCorners BrickVolume::cornersOf(std::size_t brick, const glm::ivec3& cell) const {
     CellCorners corners;
-    for (int k = 0; k < 8; ++k) {
-        const std::size_t i = valueAt(brick, valueIndex(cell.x + (k >> 2), cell.y + ((k >> 1) & 1),
-                                                        cell.z + (k & 1)));
-        if (i == kNoValue)
-            continue;
-        const auto n = std::size_t(corners.count++);
-        corners.k[n] = static_cast<std::uint8_t>(k);
-        corners.value[n] = &values_[i];
+    const SlotBits& present = present_[brick];
+    const Lanes* values = values_.data() + valueBase_[brick];
+    const int first = valueIndex(cell.x, cell.y, cell.z);
+    // Corner k = dx·4 + dy·2 + dz: each (dx, dy) has its dz = 0 and 1 on
+    // adjacent slots, so one rank (valueAt()'s) serves both.
+    for (int pair = 0; pair < 4; ++pair) {
+        const int slot = first + (pair >> 1) * kSide * kSide + (pair & 1) * kSide;
+        const auto w = static_cast<std::size_t>(slot >> 6);
+        const int bit = slot & 63;
+        const std::uint64_t word = present.bits[w];
+        std::size_t rank =
+            present.rank[w] + std::size_t(popcount64(word & ((std::uint64_t(1) << bit) - 1)));
+        // (The dz = 1 slot is the next bit, in the next word after bit 63;
+        // slots end at 728, so that word exists.)
+        const std::uint64_t high = bit < 63 ? word >> (bit + 1) : present.bits[w + 1];
+        if ((word >> bit) & 1u) {
+            const auto n = std::size_t(corners.count++);
+            corners.k[n] = static_cast<std::uint8_t>(2 * pair);
+            corners.value[n] = values + rank++;
+        }
+        if (high & 1u) {
+            const auto n = std::size_t(corners.count++);
+            corners.k[n] = static_cast<std::uint8_t>(2 * pair + 1);
+            corners.value[n] = values + rank;
+        }
     }
     return corners;
 }
@@ -398,8 +460,10 @@ void BrickVolume::forEachPiece(std::size_t brick, const glm::ivec3& b, const Gri
                       haveStart = true;
                       for (float a = s; a < sEnd;) {
                           const float e = std::min(nextSplit(a), sEnd);
-                          const Lanes fEnd = at(e);
-                          onPiece(a, e, fStart, at(0.5f * (a + e)), fEnd);
+                          Lanes fMid, fEnd;
+                          trilinear2(corners, line.at(0.5f * (a + e)) - cf, line.at(e) - cf, fMid,
+                                     fEnd);
+                          onPiece(a, e, fStart, fMid, fEnd);
                           fStart = fEnd;
                           a = e;
                       }
