@@ -230,9 +230,11 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates, 
                 // step before it, so it holds the value of the line's run
                 // before (its last sample) or zero (Run).
                 bool keptPrevious = false;
+                bool changedBefore = false; // changes(i - 1)
                 for (std::size_t i = 0; i < recorded.size(); ++i) {
-                    const bool keep =
-                        (i > 0 && changes(i - 1)) || (i + 1 < recorded.size() && changes(i));
+                    const bool changedAfter = i + 1 < recorded.size() && changes(i);
+                    const bool keep = changedBefore || changedAfter;
+                    changedBefore = changedAfter;
                     if (!keep) {
                         keptPrevious = false;
                         continue;
