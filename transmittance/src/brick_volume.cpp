@@ -47,15 +47,31 @@ inline Half loadHalf(const Lanes& v, int h) {
 
 inline void storeHalf(Lanes& v, int h, const Half& r) { std::memcpy(v.v + 4 * h, &r, sizeof(r)); }
 
+/// The trilinear weights of the 8 corners k = dx·4 + dy·2 + dz at fractions
+/// f, each (wx·wy)·wz: all 8 in four vector products, where each corner's
+/// own three loads and two products took more than its sums.
+struct CornerWeights {
+    alignas(16) float w[8];
+
+    explicit CornerWeights(const Vec3f& f) {
+        const float x0 = 1.0f - f.x, y0 = 1.0f - f.y, z0 = 1.0f - f.z;
+        const Half xy = Half{x0, x0, f.x, f.x} * Half{y0, f.y, y0, f.y};
+        const Half z = {z0, f.z, z0, f.z};
+        const Half low = Half{xy[0], xy[0], xy[1], xy[1]} * z;  // dx = 0
+        const Half high = Half{xy[2], xy[2], xy[3], xy[3]} * z; // dx = 1
+        std::memcpy(w, &low, sizeof(low));
+        std::memcpy(w + 4, &high, sizeof(high));
+    }
+};
+
 /// Trilinear interpolation of a cell's corners at fractions f. The corners
 /// left out are zero, so the sum is the 8-corner sum, bit for bit (adding
 /// w·0 to a non-negative sum leaves it as it is).
 inline Lanes trilinear(const CellCorners& c, const Vec3f& f) {
-    const float wx[2] = {1.0f - f.x, f.x}, wy[2] = {1.0f - f.y, f.y}, wz[2] = {1.0f - f.z, f.z};
+    const CornerWeights weights(f);
     Half r0 = {}, r1 = {};
     for (int i = 0; i < c.count; ++i) {
-        const int k = c.k[std::size_t(i)];
-        const float w = wx[k >> 2] * wy[(k >> 1) & 1] * wz[k & 1];
+        const float w = weights.w[c.k[std::size_t(i)]];
         const Lanes& v = *c.value[std::size_t(i)];
         r0 += w * loadHalf(v, 0);
         r1 += w * loadHalf(v, 1);
@@ -71,13 +87,11 @@ inline Lanes trilinear(const CellCorners& c, const Vec3f& f) {
 /// where one evaluation after the other waited on each add's latency.
 inline void trilinear2(const CellCorners& c, const Vec3f& f, const Vec3f& g, Lanes& atF,
                        Lanes& atG) {
-    const float fx[2] = {1.0f - f.x, f.x}, fy[2] = {1.0f - f.y, f.y}, fz[2] = {1.0f - f.z, f.z};
-    const float gx[2] = {1.0f - g.x, g.x}, gy[2] = {1.0f - g.y, g.y}, gz[2] = {1.0f - g.z, g.z};
+    const CornerWeights weightsF(f), weightsG(g);
     Half f0 = {}, f1 = {}, g0 = {}, g1 = {};
     for (int i = 0; i < c.count; ++i) {
-        const int k = c.k[std::size_t(i)];
-        const float wf = fx[k >> 2] * fy[(k >> 1) & 1] * fz[k & 1];
-        const float wg = gx[k >> 2] * gy[(k >> 1) & 1] * gz[k & 1];
+        const std::size_t k = c.k[std::size_t(i)];
+        const float wf = weightsF.w[k], wg = weightsG.w[k];
         const Lanes& v = *c.value[std::size_t(i)];
         const Half v0 = loadHalf(v, 0), v1 = loadHalf(v, 1);
         f0 += wf * v0;
@@ -509,16 +523,22 @@ void BrickVolume::integrateCumulative(const Vec3f& origin, const Vec3f& dir, flo
     const float sStart = tStart * invH_, sStep = step * invH_;
     const auto position = [&](std::size_t k) { return sStart + static_cast<float>(k) * sStep; };
     Lanes sum;
-    std::size_t next = 0; // the next sample to record
+    std::size_t next = 0;     // the next sample to record
+    float nextAt = position(0); // its position; +∞ once every sample is recorded
+    const auto setNext = [&](std::size_t k) {
+        next = k;
+        nextAt = k < count ? position(k) : kInfinity;
+    };
     // Records sample `next` with the running sum (in world units).
     const auto recordNext = [&] {
-        out.push_back({next++, sum});
+        out.push_back({next, sum});
         for (float& lane : out.back().value.v)
             lane *= static_cast<float>(h_);
+        setNext(next + 1);
     };
     // Records every sample from `next` to the last at or before s.
     const auto recordUpTo = [&](float s) {
-        while (next < count && position(next) <= s)
+        while (nextAt <= s)
             recordNext();
     };
     // Entering a brick at s: the samples since the last brick hold the
@@ -526,7 +546,7 @@ void BrickVolume::integrateCumulative(const Vec3f& origin, const Vec3f& dir, flo
     // and the last (which the brick's first piece interpolates from) are
     // recorded; those between are skipped.
     const auto skipTo = [&](float s) {
-        if (next < count && position(next) <= s)
+        if (nextAt <= s)
             recordNext();
         const float local = std::floor((s - sStart) / sStep);
         std::size_t k = local > 0 ? std::min(static_cast<std::size_t>(local), count - 1) : 0;
@@ -534,7 +554,8 @@ void BrickVolume::integrateCumulative(const Vec3f& origin, const Vec3f& dir, flo
             --k;
         while (k + 1 < count && position(k + 1) <= s)
             ++k;
-        next = std::max(next, k);
+        if (k > next)
+            setNext(k);
     };
     // The candidates the line crosses over [sStart, position(count − 1)], in
     // order along it (bricks are disjoint: their crossings do not overlap).
