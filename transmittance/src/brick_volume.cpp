@@ -310,12 +310,20 @@ void BrickVolume::allocateValues() {
                     const int slot = int(w) * 64 + std::countr_zero(word);
                     const int x = slot / (kSide * kSide), y = slot / kSide % kSide,
                               z = slot % kSide;
-                    // The value is a corner of the cells (x − 1 .. x, y − 1 .. y, z − 1 .. z).
+                    // The value is a corner of the cells (x − 1 .. x, y − 1 .. y,
+                    // z − 1 .. z) within the brick: their (y, z) bits at once,
+                    // bit cy·8 + cz, as the bytes cy of their z bits.
+                    const auto within = [](int c) { // bits c − 1 and c of 0 .. 7
+                        return ((std::uint64_t(1) << c) | (std::uint64_t(1) << c >> 1)) & 0xFFu;
+                    };
+                    const std::uint64_t cz = within(z), cy = within(y);
+                    const std::uint64_t cells =
+                        (((cy & 1u) | (cy & 2u) << 7 | (cy & 4u) << 14 | (cy & 8u) << 21 |
+                          (cy & 16u) << 28 | (cy & 32u) << 35 | (cy & 64u) << 42 |
+                          (cy & 128u) << 49) *
+                         cz);
                     for (int cx = std::max(x - 1, 0); cx <= std::min(x, kBrick - 1); ++cx)
-                        for (int cy = std::max(y - 1, 0); cy <= std::min(y, kBrick - 1); ++cy)
-                            for (int cz = std::max(z - 1, 0); cz <= std::min(z, kBrick - 1); ++cz)
-                                cellMask_[brick][std::size_t(cx)] |= std::uint64_t(1)
-                                                                     << (cy * 8 + cz);
+                        cellMask_[brick][std::size_t(cx)] |= cells;
                 }
             }
             counts[brick] = next;
@@ -347,13 +355,17 @@ BrickVolume::BrickSet BrickVolume::brickSet(const glm::ivec3& b) const {
 template <typename F>
 void BrickVolume::forEachCopy(const BrickSet& bricks, const glm::ivec3& local, F&& f) {
     // The voxel's own brick, and the aprons below for each axis where it is on the low face.
+    // (The submasks of onLowFace, from it down to 0: one for a voxel off the
+    // low faces, as most are, where testing all 8 cost more than the copy.)
     const int onLowFace = (local.x == 0 ? 4 : 0) | (local.y == 0 ? 2 : 0) | (local.z == 0 ? 1 : 0);
-    for (int mask = 0; mask < 8; ++mask) {
-        if ((mask & onLowFace) != mask || bricks.brick[mask] < 0)
-            continue;
-        const glm::ivec3 l =
-            local + kBrick * glm::ivec3((mask >> 2) & 1, (mask >> 1) & 1, mask & 1);
-        f(static_cast<std::size_t>(bricks.brick[mask]), valueIndex(l.x, l.y, l.z));
+    for (int mask = onLowFace;; mask = (mask - 1) & onLowFace) {
+        if (bricks.brick[mask] >= 0) {
+            const glm::ivec3 l =
+                local + kBrick * glm::ivec3((mask >> 2) & 1, (mask >> 1) & 1, mask & 1);
+            f(static_cast<std::size_t>(bricks.brick[mask]), valueIndex(l.x, l.y, l.z));
+        }
+        if (mask == 0)
+            break;
     }
 }
 
