@@ -610,7 +610,11 @@ void BrickVolume::integrateCumulative(const Vec3f& origin, const Vec3f& dir, flo
         forEachPiece(
             crossing.brick, b, line, sa, sb,
             [&](float t) {
-                const float k = std::floor((t - sStart) / sStep) + 1.0f;
+                // (floorToInt: std::floor is a long sequence on x86-64's
+                // baseline; t lies within the line's samples, whose count is
+                // far below 2^31, where both give the same float.)
+                const float k =
+                    static_cast<float>(floorToInt((t - sStart) / sStep)) + 1.0f;
                 const float split = sStart + k * sStep;
                 return split > t ? split : split + sStep; // rounding at a sample
             },
