@@ -45,7 +45,9 @@ inline Half loadHalf(const Lanes& v, int h) {
     return r;
 }
 
-inline void storeHalf(Lanes& v, int h, const Half& r) { std::memcpy(v.v + 4 * h, &r, sizeof(r)); }
+inline void storeHalf(Lanes& v, int h, const Half& r) {
+    std::memcpy(v.v + 4 * h, &r, sizeof(r));
+}
 
 /// The trilinear weights of the 8 corners k = dx·4 + dy·2 + dz at fractions
 /// f, each (wx·wy)·wz: all 8 in four vector products, where each corner's
@@ -535,7 +537,7 @@ void BrickVolume::integrateCumulative(const Vec3f& origin, const Vec3f& dir, flo
     const float sStart = tStart * invH_, sStep = step * invH_;
     const auto position = [&](std::size_t k) { return sStart + static_cast<float>(k) * sStep; };
     Lanes sum;
-    std::size_t next = 0;     // the next sample to record
+    std::size_t next = 0;       // the next sample to record
     float nextAt = position(0); // its position; +∞ once every sample is recorded
     const auto setNext = [&](std::size_t k) {
         next = k;
@@ -613,8 +615,7 @@ void BrickVolume::integrateCumulative(const Vec3f& origin, const Vec3f& dir, flo
                 // (floorToInt: std::floor is a long sequence on x86-64's
                 // baseline; t lies within the line's samples, whose count is
                 // far below 2^31, where both give the same float.)
-                const float k =
-                    static_cast<float>(floorToInt((t - sStart) / sStep)) + 1.0f;
+                const float k = static_cast<float>(floorToInt((t - sStart) / sStep)) + 1.0f;
                 const float split = sStart + k * sStep;
                 return split > t ? split : split + sStep; // rounding at a sample
             },
