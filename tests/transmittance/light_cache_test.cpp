@@ -134,9 +134,12 @@ TEST(LightDiskCache, AnIntactEntryThatIsNoCacheIsComputedAgainAndReplaced) {
         EXPECT_TRUE(bits(s.evaluate(light, &after)) == bits(alone));
         EXPECT_EQ(after.stats().corrupt, 0u);
     };
-    // The magic; the first entry of the line index (a lookup would read past
-    // the runs); the lattice spacing.
+    // The magic, and the previous format's (whose runs stored their first
+    // sample: read as this format's, every lookup would be off by a step);
+    // the first entry of the line index (a lookup would read past the runs);
+    // the lattice spacing.
     rewrite(0, "XXXXXXXX", 8);
+    rewrite(0, "HVXLSC01", 8);
     const std::uint32_t farRun = 1u << 30;
     rewrite(8 + 1 + 4 * 12 + 3 * 4 + 4 * 4 + 8 + 8, &farRun, 4);
     const float nan = std::numeric_limits<float>::quiet_NaN();

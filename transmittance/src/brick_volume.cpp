@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <memory>
 #include <new>
 #include <limits>
@@ -32,26 +33,86 @@ int valueIndex(int x, int y, int z) {
     return (x * BrickVolume::kSide + y) * BrickVolume::kSide + z;
 }
 
+/// Half of a Lanes value in a SIMD register (GCC's and Clang's vector
+/// extension: SSE on x86-64's baseline, the same elementwise arithmetic in
+/// the same order as on floats, so the same bits). Loops over the 8 floats
+/// kept their sums in memory between corners.
+using Half = float __attribute__((vector_size(16)));
+
+inline Half loadHalf(const Lanes& v, int h) {
+    Half r;
+    std::memcpy(&r, v.v + 4 * h, sizeof(r));
+    return r;
+}
+
+inline void storeHalf(Lanes& v, int h, const Half& r) {
+    std::memcpy(v.v + 4 * h, &r, sizeof(r));
+}
+
+/// The trilinear weights of the 8 corners k = dx·4 + dy·2 + dz at fractions
+/// f, each (wx·wy)·wz: all 8 in four vector products, where each corner's
+/// own three loads and two products took more than its sums.
+struct CornerWeights {
+    alignas(16) float w[8];
+
+    explicit CornerWeights(const Vec3f& f) {
+        const float x0 = 1.0f - f.x, y0 = 1.0f - f.y, z0 = 1.0f - f.z;
+        const Half xy = Half{x0, x0, f.x, f.x} * Half{y0, f.y, y0, f.y};
+        const Half z = {z0, f.z, z0, f.z};
+        const Half low = Half{xy[0], xy[0], xy[1], xy[1]} * z;  // dx = 0
+        const Half high = Half{xy[2], xy[2], xy[3], xy[3]} * z; // dx = 1
+        std::memcpy(w, &low, sizeof(low));
+        std::memcpy(w + 4, &high, sizeof(high));
+    }
+};
+
 /// Trilinear interpolation of a cell's corners at fractions f. The corners
 /// left out are zero, so the sum is the 8-corner sum, bit for bit (adding
 /// w·0 to a non-negative sum leaves it as it is).
 inline Lanes trilinear(const CellCorners& c, const Vec3f& f) {
-    const float wx[2] = {1.0f - f.x, f.x}, wy[2] = {1.0f - f.y, f.y}, wz[2] = {1.0f - f.z, f.z};
-    Lanes r;
+    const CornerWeights weights(f);
+    Half r0 = {}, r1 = {};
     for (int i = 0; i < c.count; ++i) {
-        const int k = c.k[std::size_t(i)];
-        const float w = wx[k >> 2] * wy[(k >> 1) & 1] * wz[k & 1];
+        const float w = weights.w[c.k[std::size_t(i)]];
         const Lanes& v = *c.value[std::size_t(i)];
-        for (int lane = 0; lane < 8; ++lane)
-            r.v[lane] += w * v.v[lane];
+        r0 += w * loadHalf(v, 0);
+        r1 += w * loadHalf(v, 1);
     }
+    Lanes r;
+    storeHalf(r, 0, r0);
+    storeHalf(r, 1, r1);
     return r;
+}
+
+/// trilinear() at fractions f and g together (a piece's middle and end): the
+/// same sums in the same order, as two independent chains of additions
+/// where one evaluation after the other waited on each add's latency.
+inline void trilinear2(const CellCorners& c, const Vec3f& f, const Vec3f& g, Lanes& atF,
+                       Lanes& atG) {
+    const CornerWeights weightsF(f), weightsG(g);
+    Half f0 = {}, f1 = {}, g0 = {}, g1 = {};
+    for (int i = 0; i < c.count; ++i) {
+        const std::size_t k = c.k[std::size_t(i)];
+        const float wf = weightsF.w[k], wg = weightsG.w[k];
+        const Lanes& v = *c.value[std::size_t(i)];
+        const Half v0 = loadHalf(v, 0), v1 = loadHalf(v, 1);
+        f0 += wf * v0;
+        f1 += wf * v1;
+        g0 += wg * v0;
+        g1 += wg * v1;
+    }
+    storeHalf(atF, 0, f0);
+    storeHalf(atF, 1, f1);
+    storeHalf(atG, 0, g0);
+    storeHalf(atG, 1, g1);
 }
 
 /// a += w·(f0 + 4 fm + f1), lane by lane.
 inline void addSimpson(Lanes& a, const Lanes& f0, const Lanes& fm, const Lanes& f1, float w) {
-    for (int lane = 0; lane < 8; ++lane)
-        a.v[lane] += w * (f0.v[lane] + 4.0f * fm.v[lane] + f1.v[lane]);
+    for (int h = 0; h < 2; ++h)
+        storeHalf(a, h,
+                  loadHalf(a, h) +
+                      w * (loadHalf(f0, h) + 4.0f * loadHalf(fm, h) + loadHalf(f1, h)));
 }
 
 /// Bit of cell c in a bitmap of the box [lo, hi] (x fastest).
@@ -251,12 +312,20 @@ void BrickVolume::allocateValues() {
                     const int slot = int(w) * 64 + std::countr_zero(word);
                     const int x = slot / (kSide * kSide), y = slot / kSide % kSide,
                               z = slot % kSide;
-                    // The value is a corner of the cells (x − 1 .. x, y − 1 .. y, z − 1 .. z).
+                    // The value is a corner of the cells (x − 1 .. x, y − 1 .. y,
+                    // z − 1 .. z) within the brick: their (y, z) bits at once,
+                    // bit cy·8 + cz, as the bytes cy of their z bits.
+                    const auto within = [](int c) { // bits c − 1 and c of 0 .. 7
+                        return ((std::uint64_t(1) << c) | (std::uint64_t(1) << c >> 1)) & 0xFFu;
+                    };
+                    const std::uint64_t cz = within(z), cy = within(y);
+                    const std::uint64_t cells =
+                        (((cy & 1u) | (cy & 2u) << 7 | (cy & 4u) << 14 | (cy & 8u) << 21 |
+                          (cy & 16u) << 28 | (cy & 32u) << 35 | (cy & 64u) << 42 |
+                          (cy & 128u) << 49) *
+                         cz);
                     for (int cx = std::max(x - 1, 0); cx <= std::min(x, kBrick - 1); ++cx)
-                        for (int cy = std::max(y - 1, 0); cy <= std::min(y, kBrick - 1); ++cy)
-                            for (int cz = std::max(z - 1, 0); cz <= std::min(z, kBrick - 1); ++cz)
-                                cellMask_[brick][std::size_t(cx)] |= std::uint64_t(1)
-                                                                     << (cy * 8 + cz);
+                        cellMask_[brick][std::size_t(cx)] |= cells;
                 }
             }
             counts[brick] = next;
@@ -288,13 +357,17 @@ BrickVolume::BrickSet BrickVolume::brickSet(const glm::ivec3& b) const {
 template <typename F>
 void BrickVolume::forEachCopy(const BrickSet& bricks, const glm::ivec3& local, F&& f) {
     // The voxel's own brick, and the aprons below for each axis where it is on the low face.
+    // (The submasks of onLowFace, from it down to 0: one for a voxel off the
+    // low faces, as most are, where testing all 8 cost more than the copy.)
     const int onLowFace = (local.x == 0 ? 4 : 0) | (local.y == 0 ? 2 : 0) | (local.z == 0 ? 1 : 0);
-    for (int mask = 0; mask < 8; ++mask) {
-        if ((mask & onLowFace) != mask || bricks.brick[mask] < 0)
-            continue;
-        const glm::ivec3 l =
-            local + kBrick * glm::ivec3((mask >> 2) & 1, (mask >> 1) & 1, mask & 1);
-        f(static_cast<std::size_t>(bricks.brick[mask]), valueIndex(l.x, l.y, l.z));
+    for (int mask = onLowFace;; mask = (mask - 1) & onLowFace) {
+        if (bricks.brick[mask] >= 0) {
+            const glm::ivec3 l =
+                local + kBrick * glm::ivec3((mask >> 2) & 1, (mask >> 1) & 1, mask & 1);
+            f(static_cast<std::size_t>(bricks.brick[mask]), valueIndex(l.x, l.y, l.z));
+        }
+        if (mask == 0)
+            break;
     }
 }
 
@@ -314,14 +387,31 @@ void BrickVolume::set(const BrickSet& bricks, const glm::ivec3& local, const Opt
 
 CellCorners BrickVolume::cornersOf(std::size_t brick, const glm::ivec3& cell) const {
     CellCorners corners;
-    for (int k = 0; k < 8; ++k) {
-        const std::size_t i = valueAt(brick, valueIndex(cell.x + (k >> 2), cell.y + ((k >> 1) & 1),
-                                                        cell.z + (k & 1)));
-        if (i == kNoValue)
-            continue;
-        const auto n = std::size_t(corners.count++);
-        corners.k[n] = static_cast<std::uint8_t>(k);
-        corners.value[n] = &values_[i];
+    const SlotBits& present = present_[brick];
+    const Lanes* values = values_.data() + valueBase_[brick];
+    const int first = valueIndex(cell.x, cell.y, cell.z);
+    // Corner k = dx·4 + dy·2 + dz: each (dx, dy) has its dz = 0 and 1 on
+    // adjacent slots, so one rank (valueAt()'s) serves both.
+    for (int pair = 0; pair < 4; ++pair) {
+        const int slot = first + (pair >> 1) * kSide * kSide + (pair & 1) * kSide;
+        const auto w = static_cast<std::size_t>(slot >> 6);
+        const int bit = slot & 63;
+        const std::uint64_t word = present.bits[w];
+        std::size_t rank =
+            present.rank[w] + std::size_t(popcount64(word & ((std::uint64_t(1) << bit) - 1)));
+        // (The dz = 1 slot is the next bit, in the next word after bit 63;
+        // slots end at 728, so that word exists.)
+        const std::uint64_t high = bit < 63 ? word >> (bit + 1) : present.bits[w + 1];
+        if ((word >> bit) & 1u) {
+            const auto n = std::size_t(corners.count++);
+            corners.k[n] = static_cast<std::uint8_t>(2 * pair);
+            corners.value[n] = values + rank++;
+        }
+        if (high & 1u) {
+            const auto n = std::size_t(corners.count++);
+            corners.k[n] = static_cast<std::uint8_t>(2 * pair + 1);
+            corners.value[n] = values + rank;
+        }
     }
     return corners;
 }
@@ -398,8 +488,10 @@ void BrickVolume::forEachPiece(std::size_t brick, const glm::ivec3& b, const Gri
                       haveStart = true;
                       for (float a = s; a < sEnd;) {
                           const float e = std::min(nextSplit(a), sEnd);
-                          const Lanes fEnd = at(e);
-                          onPiece(a, e, fStart, at(0.5f * (a + e)), fEnd);
+                          Lanes fMid, fEnd;
+                          trilinear2(corners, line.at(0.5f * (a + e)) - cf, line.at(e) - cf, fMid,
+                                     fEnd);
+                          onPiece(a, e, fStart, fMid, fEnd);
                           fStart = fEnd;
                           a = e;
                       }
@@ -445,16 +537,22 @@ void BrickVolume::integrateCumulative(const Vec3f& origin, const Vec3f& dir, flo
     const float sStart = tStart * invH_, sStep = step * invH_;
     const auto position = [&](std::size_t k) { return sStart + static_cast<float>(k) * sStep; };
     Lanes sum;
-    std::size_t next = 0; // the next sample to record
+    std::size_t next = 0;       // the next sample to record
+    float nextAt = position(0); // its position; +∞ once every sample is recorded
+    const auto setNext = [&](std::size_t k) {
+        next = k;
+        nextAt = k < count ? position(k) : kInfinity;
+    };
     // Records sample `next` with the running sum (in world units).
     const auto recordNext = [&] {
-        out.push_back({next++, sum});
+        out.push_back({next, sum});
         for (float& lane : out.back().value.v)
             lane *= static_cast<float>(h_);
+        setNext(next + 1);
     };
     // Records every sample from `next` to the last at or before s.
     const auto recordUpTo = [&](float s) {
-        while (next < count && position(next) <= s)
+        while (nextAt <= s)
             recordNext();
     };
     // Entering a brick at s: the samples since the last brick hold the
@@ -462,7 +560,7 @@ void BrickVolume::integrateCumulative(const Vec3f& origin, const Vec3f& dir, flo
     // and the last (which the brick's first piece interpolates from) are
     // recorded; those between are skipped.
     const auto skipTo = [&](float s) {
-        if (next < count && position(next) <= s)
+        if (nextAt <= s)
             recordNext();
         const float local = std::floor((s - sStart) / sStep);
         std::size_t k = local > 0 ? std::min(static_cast<std::size_t>(local), count - 1) : 0;
@@ -470,7 +568,8 @@ void BrickVolume::integrateCumulative(const Vec3f& origin, const Vec3f& dir, flo
             --k;
         while (k + 1 < count && position(k + 1) <= s)
             ++k;
-        next = std::max(next, k);
+        if (k > next)
+            setNext(k);
     };
     // The candidates the line crosses over [sStart, position(count − 1)], in
     // order along it (bricks are disjoint: their crossings do not overlap).
@@ -513,7 +612,10 @@ void BrickVolume::integrateCumulative(const Vec3f& origin, const Vec3f& dir, flo
         forEachPiece(
             crossing.brick, b, line, sa, sb,
             [&](float t) {
-                const float k = std::floor((t - sStart) / sStep) + 1.0f;
+                // (floorToInt: std::floor is a long sequence on x86-64's
+                // baseline; t lies within the line's samples, whose count is
+                // far below 2^31, where both give the same float.)
+                const float k = static_cast<float>(floorToInt((t - sStart) / sStep)) + 1.0f;
                 const float split = sStart + k * sStep;
                 return split > t ? split : split + sStep; // rounding at a sample
             },

@@ -74,6 +74,20 @@ struct alignas(32) Lanes {
     }
 };
 
+/// std::popcount inline: x86-64's baseline has no POPCNT instruction, and
+/// there GCC calls libgcc's __popcountdi2 for std::popcount (2% of a fine-voxel
+/// render's CPU samples, from the light cache's cell walk, valueAt()).
+inline int popcount64(std::uint64_t x) {
+#if defined(__POPCNT__)
+    return std::popcount(x);
+#else
+    x -= (x >> 1) & 0x5555555555555555u;
+    x = (x & 0x3333333333333333u) + ((x >> 2) & 0x3333333333333333u);
+    x = (x + (x >> 4)) & 0x0f0f0f0f0f0f0f0fu;
+    return static_cast<int>((x * 0x0101010101010101u) >> 56);
+#endif
+}
+
 /// The corners of a cell that hold a value: at fine voxels a strand crosses a
 /// brick alone, and a cell a line walks has few of its 8 (the others read
 /// zero and add nothing to an interpolation).
@@ -216,7 +230,7 @@ private:
         const std::uint64_t bit = std::uint64_t(1) << (slot & 63);
         const std::uint64_t word = present_[brick].bits[w];
         return (word & bit) ? valueBase_[brick] + present_[brick].rank[w] +
-                                  std::size_t(std::popcount(word & (bit - 1)))
+                                  std::size_t(popcount64(word & (bit - 1)))
                             : kNoValue;
     }
     static constexpr std::size_t kNoValue = ~std::size_t(0);

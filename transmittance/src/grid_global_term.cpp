@@ -179,6 +179,18 @@ glm::ivec3 localOf(const FiberBlock& block, const openvdb::Coord& ijk) {
     return {l.x(), l.y(), l.z()};
 }
 
+/// Which low faces of a block hold an active voxel (4 x, 2 y, 1 z), from its
+/// mask's words: word x holds the voxels (x, y, z) at bits y·8 + z. (Visiting
+/// the voxels one by one was a serial pass over all of them.)
+int lowFacesOf(const FiberBlock& block) {
+    static_assert(FiberBlock::kDim == 8);
+    std::uint64_t any = 0;
+    for (openvdb::Index w = 0; w < 8; ++w)
+        any |= block.active.getWord<std::uint64_t>(w);
+    return (block.active.getWord<std::uint64_t>(0) != 0 ? 4 : 0) | ((any & 0xFFu) != 0 ? 2 : 0) |
+           ((any & 0x0101010101010101u) != 0 ? 1 : 0);
+}
+
 /// A grid model's LightWorkspace: the rates volume of the last light.
 struct RatesWorkspace final : LightWorkspace {
     explicit RatesWorkspace(const GridModel& m)
@@ -192,14 +204,8 @@ BrickVolume GridModel::reserveRates() const {
     BrickVolume volume(grid_.info.voxelSize);
     const std::vector<FiberBlock>& blocks = grid_.blocks;
     // Bricks reserved serially (their order is the blocks'), voxels in parallel.
-    for (const FiberBlock& block : blocks) {
-        int lowFaces = 0;
-        FiberGrid::forEachVoxelOf(block, [&](std::size_t, const openvdb::Coord& ijk) {
-            const glm::ivec3 l = localOf(block, ijk);
-            lowFaces |= (l.x == 0 ? 4 : 0) | (l.y == 0 ? 2 : 0) | (l.z == 0 ? 1 : 0);
-        });
-        volume.reserveBrick(brickOf(block), lowFaces);
-    }
+    for (const FiberBlock& block : blocks)
+        volume.reserveBrick(brickOf(block), lowFacesOf(block));
     volume.allocateSlots();
     tbb::parallel_for(
         tbb::blocked_range<std::size_t>(0, blocks.size(), 16), [&](const auto& range) {

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -225,19 +226,31 @@ std::optional<LightSpaceCache> LightSpaceCache::build(const BrickVolume& rates, 
                                        std::end(recorded[i].value.v),
                                        std::begin(recorded[i + 1].value.v));
                 };
+                // A run's first sample is not stored: nothing changed in the
+                // step before it, so it holds the value of the line's run
+                // before (its last sample) or zero (Run).
                 bool keptPrevious = false;
+                bool changedBefore = false; // changes(i - 1)
                 for (std::size_t i = 0; i < recorded.size(); ++i) {
-                    const bool keep =
-                        (i > 0 && changes(i - 1)) || (i + 1 < recorded.size() && changes(i));
+                    const bool changedAfter = i + 1 < recorded.size() && changes(i);
+                    const bool keep = changedBefore || changedAfter;
+                    changedBefore = changedAfter;
                     if (!keep) {
                         keptPrevious = false;
                         continue;
                     }
-                    if (!keptPrevious || recorded[i].k != recorded[i - 1].k + 1)
+                    const bool first = !keptPrevious || recorded[i].k != recorded[i - 1].k + 1;
+                    keptPrevious = true;
+                    if (first) {
+                        assert(std::equal(std::begin(recorded[i].value.v),
+                                          std::end(recorded[i].value.v),
+                                          runs.size() > lineRuns[l] ? std::begin(samples.back().v)
+                                                                    : std::begin(kZero.v)));
                         runs.push_back({static_cast<std::int32_t>(recorded[i].k),
                                         static_cast<std::uint32_t>(samples.size())});
+                        continue;
+                    }
                     samples.push_back(recorded[i].value);
-                    keptPrevious = true;
                 }
                 // A tile's samples are at most its lines' lattice steps
                 // (samplesPerLine each), far below 2^32 for any volume that
@@ -303,13 +316,15 @@ inline LightSpaceCache::LineRead LightSpaceCache::alongLine(const Tile& tile, st
     while (r + 1 < r1 && float(runs[r + 1].k0) <= s)
         ++r;
     const Run& run = runs[r];
-    const std::size_t count = runs[r + 1].begin - run.begin;
+    const std::size_t count = runs[r + 1].begin - run.begin; // samples k0 + 1 .. k0 + count
     const float local = s - float(run.k0);
     const auto k = static_cast<std::size_t>(local);
     const Lanes* samples = tile.samples.data() + run.begin;
-    if (k + 1 >= count)
+    if (k >= count)
         return {samples + (count - 1), nullptr, 0.0f}; // unchanged until the next run (or for good)
-    return {samples + k, samples + k + 1, local - float(k)};
+    if (k == 0) // from sample k0: the line's run before ends with its value, or it is zero
+        return {r == r0 ? &kZero : samples - 1, samples, local};
+    return {samples + (k - 1), samples + k, local - float(k)};
 }
 
 inline Lanes LightSpaceCache::value(const LineRead& read) {

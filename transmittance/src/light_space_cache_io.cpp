@@ -1,6 +1,6 @@
 // The light-space cache as bytes (light_space_cache.h), for the disk cache
 // that render tasks share (core/disk_cache.h, pipeline's asset cache):
-//   magic "HVXLSC01", the lattice (perspective, origin, e1, e2, axis, du, h,
+//   magic "HVXLSC02", the lattice (perspective, origin, e1, e2, axis, du, h,
 //   sBase, i0, j0, ni, nj), tilesPerRow, the line → runs index, then per
 //   tile its run count, runs (k0, begin), sample count and samples (8 floats).
 // The disk cache checks its entries' integrity; deserialize() checks that the
@@ -17,7 +17,8 @@ namespace hairvox::detail {
 
 namespace {
 
-constexpr char kMagic[8] = {'H', 'V', 'X', 'L', 'S', 'C', '0', '1'};
+/// 02: a run's first sample is not stored (light_space_cache.h, Run).
+constexpr char kMagic[8] = {'H', 'V', 'X', 'L', 'S', 'C', '0', '2'};
 
 bool finite(const Vec3f& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
