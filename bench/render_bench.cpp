@@ -12,6 +12,7 @@
 //   render_bench --benchmark_filter=Head1080p      # the 1.4M-segment case alone (clean peak
 //   memory)
 //   render_bench --benchmark_filter=Turntable      # four frames, alone and sharing (FrameReuse)
+#include <hairvox/core/host.h>
 #include <hairvox/core/math.h>
 #include <hairvox/film/image_file.h>
 #include <hairvox/pipeline/pipeline.h>
@@ -22,7 +23,6 @@
 
 #include <cmath>
 #include <filesystem>
-#include <sys/resource.h>
 #include <unistd.h>
 
 namespace hairvox {
@@ -51,10 +51,9 @@ private:
     ShaderLayout layout_;
 };
 
+/// The process's peak so far (core/host.h; the host calibration is not in it).
 double peakResidentMiB() {
-    rusage usage{};
-    getrusage(RUSAGE_SELF, &usage);
-    return double(usage.ru_maxrss) / 1024.0; // ru_maxrss is in KiB on Linux
+    return peakResidentBytes() / double(1 << 20);
 }
 
 void report(benchmark::State& state, const RasterOutput& out) {

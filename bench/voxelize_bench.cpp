@@ -8,6 +8,7 @@
 // Counters: segments_per_s; voxels (active); grid_MiB (FiberGrid::memoryBytes);
 // peak_MiB (resident-set high-water mark during the splat, above the RSS
 // before it: the splat's transient memory plus the grid).
+#include <hairvox/core/host.h>
 #include <hairvox/core/parallel.h>
 #include <hairvox/strands/procedural.h>
 #include <hairvox/voxelize/fiber_grid.h>
@@ -15,7 +16,6 @@
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
-#include <fstream>
 #include <malloc.h>
 #include <map>
 #include <string>
@@ -37,22 +37,11 @@ const Groom& wavyGroom(std::uint32_t strands) {
     return it->second;
 }
 
-/// A field of /proc/self/status in kB ("VmRSS", "VmHWM"), 0 if unavailable.
-double statusKiB(const std::string& field) {
-    std::ifstream in("/proc/self/status");
-    std::string line;
-    while (std::getline(in, line))
-        if (line.rfind(field + ":", 0) == 0)
-            return std::stod(line.substr(field.size() + 1));
-    return 0;
-}
-
-/// Returns freed heap to the system, then resets the peak-RSS counter VmHWM to
-/// the current RSS (Linux ≥ 4.0), so that the next peak is this splat's own.
+/// Returns freed heap to the system, then makes the peak resident set the
+/// current one (core/host.h), so that the next peak is this splat's own.
 void resetPeakRss() {
     ::malloc_trim(0);
-    std::ofstream clear("/proc/self/clear_refs");
-    clear << "5";
+    resetPeakResidentMemory();
 }
 
 void splat(benchmark::State& state, bool tensor, int threads) {
@@ -65,11 +54,11 @@ void splat(benchmark::State& state, bool tensor, int threads) {
     for (auto _ : state) {
         state.PauseTiming();
         resetPeakRss();
-        const double before = statusKiB("VmRSS");
+        const double before = residentBytes();
         state.ResumeTiming();
         const FiberGrid grid = splatStrands(groom, options);
         state.PauseTiming();
-        peakMiB = std::max(peakMiB, (statusKiB("VmHWM") - before) / 1024.0);
+        peakMiB = std::max(peakMiB, (peakResidentBytes() - before) / double(1 << 20));
         voxels = grid.activeVoxelCount();
         gridBytes = grid.memoryBytes();
         state.ResumeTiming();

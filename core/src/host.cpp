@@ -4,14 +4,16 @@
 #include <bit>
 #include <chrono>
 #include <cstdint>
+#include <cstdlib>
 #include <fstream>
 #include <iomanip>
 #include <limits>
 #include <numeric>
+#include <new>
 #include <sched.h>
+#include <sys/mman.h>
 #include <thread>
 #include <unistd.h>
-#include <vector>
 
 namespace hairvox {
 
@@ -45,6 +47,41 @@ unsigned countLogicalCores() {
     return std::max(1u, std::thread::hardware_concurrency());
 }
 
+/// An array in pages of its own, given back to the kernel when it goes (an
+/// allocator would keep them, resident, for later allocations): the
+/// calibration leaves no memory behind.
+template <class T>
+class MappedArray {
+public:
+    explicit MappedArray(std::size_t n) : n_(n) {
+        void* p = mmap(nullptr, bytes(), PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+        if (p == MAP_FAILED)
+            throw std::bad_alloc();
+        data_ = static_cast<T*>(p);
+    }
+    MappedArray(const MappedArray&) = delete;
+    MappedArray& operator=(const MappedArray&) = delete;
+    ~MappedArray() { munmap(data_, bytes()); }
+
+    T* data() { return data_; }
+    T& operator[](std::size_t i) { return data_[i]; }
+
+private:
+    std::size_t bytes() const { return std::max<std::size_t>(1, n_ * sizeof(T)); }
+    T* data_ = nullptr;
+    std::size_t n_ = 0;
+};
+
+/// A field of /proc/self/status in bytes ("VmRSS", "VmHWM": given in kB), 0 if unreadable.
+double statusBytes(const std::string& field) {
+    std::ifstream in("/proc/self/status");
+    std::string line;
+    while (std::getline(in, line))
+        if (line.rfind(field + ":", 0) == 0)
+            return 1024.0 * std::strtod(line.c_str() + field.size() + 1, nullptr);
+    return 0;
+}
+
 /// The triad's arrays together: 3× the L3 cache, within [96, 384] MiB.
 std::size_t triadBytes() {
     constexpr std::size_t kMiB = std::size_t(1) << 20;
@@ -55,7 +92,12 @@ std::size_t triadBytes() {
 
 /// The best of a few passes of a[i] = b[i] + s·c[i]: bytes of a, b and c per second.
 double triadBandwidth(std::size_t n) {
-    std::vector<float> a(n, 0.0f), b(n, 1.0f), c(n, 2.0f); // written: first touch here, untimed
+    MappedArray<float> a(n), b(n), c(n);
+    for (std::size_t i = 0; i < n; ++i) { // written: first touch here, untimed
+        a[i] = 0.0f;
+        b[i] = 1.0f;
+        c[i] = 2.0f;
+    }
     const float s = 0.5f;
     double best = std::numeric_limits<double>::infinity();
     double spent = 0;
@@ -86,7 +128,7 @@ double missLatency(std::size_t bytes) {
     const std::size_t lines = std::bit_floor(bytes / 64);
     const std::uint64_t mask = lines - 1;
     // Slot 0 of line k holds the first slot of the line after it.
-    std::vector<std::uint32_t> next(lines * kLineSlots);
+    MappedArray<std::uint32_t> next(lines * kLineSlots);
     for (std::uint64_t k = 0; k < lines; ++k)
         next[k * kLineSlots] = static_cast<std::uint32_t>(
             ((k * 6364136223846793005ull + 1442695040888963407ull) & mask) * kLineSlots);
@@ -140,7 +182,21 @@ MachineCalibration calibrateMachine() {
     c.missLatencyNs = missLatency(c.arrayBytes);
     c.baselineFlopsPerSecond = baselineFlops();
     c.seconds = secondsSince(start);
+    resetPeakResidentMemory(); // the arrays are unmapped: not part of a later peak
     return c;
+}
+
+double residentBytes() {
+    return statusBytes("VmRSS");
+}
+
+double peakResidentBytes() {
+    return statusBytes("VmHWM");
+}
+
+void resetPeakResidentMemory() {
+    std::ofstream clear("/proc/self/clear_refs");
+    clear << "5";
 }
 
 std::ostream& operator<<(std::ostream& os, const HostInfo& h) {

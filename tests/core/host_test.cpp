@@ -7,6 +7,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <vector>
 
 namespace hairvox {
 namespace {
@@ -50,6 +51,27 @@ TEST(Host, CalibrationFiguresAreFiniteAndPositive) {
     std::ostringstream os;
     os << c;
     EXPECT_NE(os.str().find("GB/s"), std::string::npos) << os.str();
+}
+
+TEST(Host, TheCalibrationLeavesNoPeakAndAPeakIsSeen) {
+    // The calibration touches ≥ 96 MiB and gives it back: the peak after it
+    // is the resident set's, not the calibration's (a benchmark's peak
+    // memory would otherwise be at least its arrays).
+    const MachineCalibration c = calibrateMachine();
+    const double afterwards = peakResidentBytes();
+    ASSERT_GT(residentBytes(), 0.0) << "/proc/self/status unreadable";
+    EXPECT_GE(afterwards, residentBytes() - 4096.0);
+    EXPECT_LT(afterwards, residentBytes() + 0.5 * double(c.arrayBytes));
+    // 64 MiB touched now is seen in the peak, and stays there once freed.
+    {
+        std::vector<char> block(std::size_t(64) << 20);
+        for (std::size_t i = 0; i < block.size(); i += 4096)
+            block[i] = char(i);
+        EXPECT_EQ(block[4096], char(4096 % 256));
+    }
+    EXPECT_GE(peakResidentBytes(), afterwards + 60.0 * double(1 << 20));
+    resetPeakResidentMemory();
+    EXPECT_LT(peakResidentBytes(), residentBytes() + 32.0 * double(1 << 20));
 }
 
 } // namespace

@@ -4,7 +4,7 @@
 //
 // Isolation: with a worker command (the CLI passes `hairvox bench --one`),
 // every job runs in its own child process, so its peak resident memory
-// (getrusage's ru_maxrss, process-wide and monotone) is that job's alone;
+// (its address space's VmHWM, core/host.h) is that job's alone;
 // without one (tests) jobs run in the sweep's process and peak memory is not
 // reported.
 #pragma once

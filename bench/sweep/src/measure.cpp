@@ -3,20 +3,19 @@
 #include "text.h"
 
 #include <hairvox/core/error.h>
+#include <hairvox/core/host.h>
 #include <hairvox/core/parallel.h>
 #include <hairvox/voxelize/fiber_grid.h>
 
-#include <sys/resource.h>
 
 namespace hairvox::bench {
 
 namespace {
 
-/// Peak resident memory of this process so far (ru_maxrss is in KiB on Linux).
+/// Peak resident memory of this process so far: the job's own in a worker
+/// (core/host.h: not its parent's, which ru_maxrss would carry across exec).
 double peakResidentMiB() {
-    rusage usage{};
-    getrusage(RUSAGE_SELF, &usage);
-    return double(usage.ru_maxrss) / 1024.0;
+    return peakResidentBytes() / double(1 << 20);
 }
 
 /// The lights a render evaluates (the renderer skips dark ones).

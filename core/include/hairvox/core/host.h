@@ -43,8 +43,21 @@ struct MachineCalibration {
 };
 
 /// Measures the ceilings above in about 0.2–0.4 s on a quiet machine (arrays
-/// of 3× the L3 cache, between 96 and 384 MiB, allocated and freed here).
+/// of 3× the L3 cache, between 96 and 384 MiB, mapped and unmapped here), then
+/// resets this process's peak resident memory (resetPeakResidentMemory) so
+/// that a peak measured after it is the program's own, not the calibration's.
 MachineCalibration calibrateMachine();
+
+/// This process's resident memory in bytes (Linux /proc/self/status; 0 where
+/// unreadable): now (VmRSS), and its peak (VmHWM) since the program started or
+/// since resetPeakResidentMemory(). The peak is this address space's own: a
+/// program started by another does not inherit its parent's, as getrusage's
+/// ru_maxrss does across execve (a benchmark's workers would each report at
+/// least their parent's peak).
+double residentBytes();
+double peakResidentBytes();
+/// Makes the peak the current resident set (5 into /proc/self/clear_refs, Linux ≥ 4.0).
+void resetPeakResidentMemory();
 
 std::ostream& operator<<(std::ostream& os, const HostInfo& h);
 std::ostream& operator<<(std::ostream& os, const MachineCalibration& c);
