@@ -86,7 +86,7 @@ TEST(Sobol, PointsAreUniformAndPairsIndependentOverSeeds) {
             SobolSampler s(std::uint64_t(k) * std::uint64_t{0x9e3779b97f4a7c15u}, index);
             const Vec2f a = s.next2D(), b = s.next2D();
             ++hist[std::size_t(a.x * bins) * bins + std::size_t(a.y * bins)];
-            const double x = a.x, y = b.x;
+            const double x = double(a.x), y = double(b.x);
             sx += x;
             sy += y;
             sxy += x * y;
