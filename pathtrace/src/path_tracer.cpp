@@ -5,8 +5,8 @@
 #include <hairvox/core/math.h>
 #include <hairvox/core/parallel.h>
 #include <hairvox/core/progress.h>
-#include <hairvox/core/rng.h>
 #include <hairvox/core/sampling.h>
+#include <hairvox/core/sobol.h>
 #include <hairvox/geometry/ray_scene.h>
 #include <hairvox/pathtrace/path_tracer.h>
 #include <hairvox/shading/marschner.h>
@@ -135,14 +135,15 @@ public:
     /// halves A and B, two independent randomizations of one sequence.
     Sample trace(int x, int y, std::uint32_t index, Counters& counters) const {
         const std::size_t pixel = std::size_t(y) * std::size_t(camera_.width()) + std::size_t(x);
-        Pcg32 rng(Hasher().value(settings_.seed).value(pixel).value(index).digest());
-        Sample out;
-
-        // The pixel position: R2 (Roberts 2018), rotated per pixel and half.
+        // Every uniform from a padded Owen-scrambled Sobol sampler (core/sobol.h):
+        // sample j of a half is the j-th point of each pair of dimensions'
+        // (0,2)-sequence, the pixel position first; the halves' randomizations
+        // are independent.
         const std::uint32_t half = index & 1u;
-        const std::uint64_t rotation = Hasher().value(settings_.seed).value(pixel).value(half).digest();
-        const Vec2f raster =
-            Vec2f(float(x), float(y)) + r2Point(double(index >> 1) + 1.0, rotation);
+        SobolSampler sampler(Hasher().value(settings_.seed).value(pixel).value(half).digest(),
+                             index >> 1);
+        Sample out;
+        const Vec2f raster = Vec2f(float(x), float(y)) + sampler.next2D();
         const Vec3f dirCam = camera_.rayDirection(raster);
         Vec3f dir = camera_.toWorldDirection(dirCam);
         // Geometry nearer than the near plane is clipped, as in the rasterizer.
@@ -227,8 +228,8 @@ public:
                 }
                 if (env_) {
                     // A direction from the map, weighted against f_s sampling's density.
-                    const EnvironmentSample es =
-                        env_->sample(rng.uniformFloat(), rng.uniformFloat());
+                    const Vec2f ue = sampler.next2D();
+                    const EnvironmentSample es = env_->sample(ue.x, ue.y);
                     const FiberAngles a = FiberAngles::fromDirections(es.omega, wo, u);
                     if (es.pdf > 0 && !es.radiance.isBlack() && a.cosTheta_i > 0) {
                         ++counters.shadowRays;
@@ -241,8 +242,8 @@ public:
                         }
                     }
                 }
-                const BcsdfSample s = bcsdf.sample(
-                    wo, u, {rng.uniformFloat(), rng.uniformFloat(), rng.uniformFloat(), rng.uniformFloat()});
+                const Vec2f u01 = sampler.next2D(), u23 = sampler.next2D();
+                const BcsdfSample s = bcsdf.sample(wo, u, {u01.x, u01.y, u23.x, u23.y});
                 if (!s.valid())
                     break;
                 continuationPdf = s.pdf;
@@ -278,8 +279,8 @@ public:
                 }
                 if (env_) {
                     // A direction from the map, weighted against cosine sampling's density.
-                    const EnvironmentSample es =
-                        env_->sample(rng.uniformFloat(), rng.uniformFloat());
+                    const Vec2f ue = sampler.next2D();
+                    const EnvironmentSample es = env_->sample(ue.x, ue.y);
                     const float cosTheta = glm::dot(n, es.omega);
                     if (es.pdf > 0 && !es.radiance.isBlack() && cosTheta > 0 &&
                         glm::dot(ng, es.omega) > 0) {
@@ -294,7 +295,8 @@ public:
                 }
                 throughput *= albedo;
                 origin = xOff;
-                dir = cosineHemisphere(n, rng.uniformFloat(), rng.uniformFloat());
+                const Vec2f uc = sampler.next2D();
+                dir = cosineHemisphere(n, uc.x, uc.y);
                 if (!(glm::dot(dir, ng) > 0))
                     break; // below the surface: the shading normal's lobe dips under it
                 continuationPdf = glm::dot(n, dir) * float(InvPi);
@@ -317,7 +319,7 @@ public:
             }
             if (events >= settings_.rouletteDepth) {
                 const float q = std::min(1.0f, throughput.maxComponent());
-                if (rng.uniformFloat() >= q)
+                if (sampler.next1D() >= q)
                     break;
                 throughput /= q;
             }

@@ -41,12 +41,20 @@
 // the throughput they still carried (the energy the cap lost).
 //
 // Sampling: samples come in two independent halves, A (even sample indices)
-// and B (odd): sample 2j + h uses a PCG32 stream seeded from (seed, pixel,
-// index) and the j-th point of the R2 low-discrepancy sequence (Roberts 2018)
-// for its position in the pixel, rotated by a random offset per pixel and
-// half. The image depends on (seed, spp) only — not on the thread count — and
-// a run that continues an earlier one from sample N on gives the image the
-// uninterrupted run would have. Work proceeds in passes of two samples per
+// and B (odd). Sample 2j + h takes every uniform — its position in the pixel
+// first, then each scattering event's — from the j-th point of a padded
+// Owen-scrambled Sobol sampler (core/sobol.h; Burley 2020, pbrt-v4's
+// PaddedSobolSampler): one (0,2)-sequence per pair of dimensions, so that the
+// first 2^m samples of a half are stratified in every pair. Its randomization
+// is seeded by (seed, pixel, h): the two halves are independent
+// randomizations of one sequence, i.e. independent, identically distributed
+// estimates — what the noise floor below needs. (One sequence split between
+// the halves would not do: its points 2j and 2j + 1 fall in opposite halves
+// of the pixel, the halves' errors would be anticorrelated and their
+// difference would overstate the whole's error.) The image depends on (seed,
+// spp) only — not on the thread count — and a run that continues an earlier
+// one from sample N on gives the image the uninterrupted run would have, its
+// samples having the same indices. Work proceeds in passes of two samples per
 // pixel (one per half: spp is rounded up to an even number); the run stops
 // after `spp` samples, at `timeLimit` seconds, or on Ctrl-C, always at the end
 // of a whole pass (a pass interrupted midway is discarded), so every pixel has
