@@ -122,10 +122,12 @@ TEST_F(KillSlow, DuringTheTableCacheWriteTheCacheStaysUsable) {
     // them (a small file: the kill may land just before or after the write).
     const fs::path cache = dir_ / "fresh-cache";
     const fs::path d = runDir("cache-kill");
+    fs::create_directories(cache); // empty: watched for the tables' temporary
     {
         test::Child child(test::renderOptions(scene_, d, cache));
-        const bool writing = test::waitFor(
-            child, [&] { return !test::temporaries(cache).empty(); }, kRenderTimeLimit);
+        // inotify, not polling: the small write can be over between two polls.
+        const bool writing =
+            test::waitForTemporaryOf(child, cache, "dual-scattering-", kRenderTimeLimit);
         child.signal(SIGKILL);
         child.wait(kRenderTimeLimit);
         ASSERT_TRUE(writing) << "the render ended before writing its table cache";

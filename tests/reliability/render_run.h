@@ -87,11 +87,13 @@ bool waitFor(Child& child, Ready ready, double timeoutSeconds) {
     return false;
 }
 
-/// Waits until a temporary of `finalName` is created in `dir` or the child
-/// ends; true if the temporary came first. Polling the directory misses a
-/// write that is over in less than the poll interval (a small PNG is), so this
-/// waits on inotify's creation event instead: it arrives when the file is
-/// created, before its bytes are written, fsync'ed and renamed.
+/// Waits until a temporary of a file whose name starts with `finalName` (the
+/// whole name, or a prefix such as "dual-scattering-" where a hash follows)
+/// is created in `dir` or the child ends; true if the temporary came first.
+/// Polling the directory misses a write that is over in less than the poll
+/// interval (a small PNG is, a table cache too), so this waits on inotify's
+/// creation event instead: it arrives when the file is created, before its
+/// bytes are written, fsync'ed and renamed.
 inline bool waitForTemporaryOf(Child& child, const std::filesystem::path& dir,
                                const std::string& finalName, double timeoutSeconds) {
     const int fd = ::inotify_init1(IN_NONBLOCK | IN_CLOEXEC);
@@ -101,7 +103,7 @@ inline bool waitForTemporaryOf(Child& child, const std::filesystem::path& dir,
             ::close(fd);
         return false;
     }
-    const std::string prefix = "." + finalName + ".tmp-";
+    const std::string prefix = "." + finalName;
     bool created = hasTemporaryOf(dir, finalName);
     const auto deadline = Clock::now() + std::chrono::duration<double>(timeoutSeconds);
     alignas(inotify_event) std::array<char, 4096> buffer{};
@@ -113,7 +115,9 @@ inline bool waitForTemporaryOf(Child& child, const std::filesystem::path& dir,
                 inotify_event event{};
                 std::memcpy(&event, buffer.data() + at, sizeof event);
                 const char* name = buffer.data() + at + sizeof(inotify_event);
-                if (event.len > 0 && std::string(name).rfind(prefix, 0) == 0)
+                const std::string createdName = event.len > 0 ? name : "";
+                if (createdName.rfind(prefix, 0) == 0 &&
+                    createdName.find(".tmp-") != std::string::npos)
                     created = true;
                 at += static_cast<ssize_t>(sizeof(inotify_event) + event.len);
             }
