@@ -56,7 +56,8 @@ MachineCalibration calibrateMachine();
 /// least their parent's peak).
 double residentBytes();
 double peakResidentBytes();
-/// Makes the peak the current resident set (5 into /proc/self/clear_refs, Linux ≥ 4.0).
+/// Makes the peak the current resident set (5 into /proc/self/clear_refs;
+/// Linux ≥ 4.0, elsewhere the peak stays).
 void resetPeakResidentMemory();
 
 std::ostream& operator<<(std::ostream& os, const HostInfo& h);
