@@ -7,7 +7,6 @@
 #include <hairvox/core/parallel.h>
 #include <hairvox/voxelize/fiber_grid.h>
 
-
 namespace hairvox::bench {
 
 namespace {
