@@ -11,9 +11,9 @@
 //               +y of the same irradiance, both integrators
 //   design      dual scattering's choices (regions K, median cut of energy
 //               or of solid angle, the regions' spread, the caches'
-//               spacings) on the default scene under studio, sky and city,
-//               against the path tracer: rel. L1 of the hair's radiance over
-//               8×8 blocks with the reference's noise removed, and the time
+//               spacings) on the default look (data/scenes/key_back.json) under studio, sky and
+//               city, against the path tracer: rel. L1 of the hair's radiance over 8×8 blocks with
+//               the reference's noise removed, and the time
 //   ratboy      Ratboy's mohawk on its body under studio.exr and sky.exr,
 //               dual scattering (grid) against the path tracer, beside the
 //               same under its two directional lights; the hair's surface
@@ -22,7 +22,7 @@
 //               city.exr at equal time
 //   regions     what the regions cost at 1024² (K, shadow rays, spacings): wall and CPU
 //               time, preparation, lookups, shading, in this process
-//   cost        the default scene at 1024², grid mode: lit by studio.exr
+//   cost        key_back.json at 1024², grid mode: lit by studio.exr
 //               against its two directional lights — wall time and peak
 //               memory of the hairvox CLI, paired runs in child processes
 //
@@ -82,6 +82,16 @@ std::string loadAverage() {
     std::string one, five, fifteen;
     in >> one >> five >> fifteen;
     return one + " " + five + " " + fifteen;
+}
+
+/// The default look under its key and back lights (data/scenes/key_back.json),
+/// its outputs cleared: the figures' base, as before the embedded default
+/// scene was lit by the studio map.
+Scene keyBackScene() {
+    Scene scene = loadScene(kData / "scenes" / "key_back.json");
+    scene.output.exr.clear();
+    scene.output.png.clear();
+    return scene;
 }
 
 /// The scene with an environment light of `map` (a file in data/hdri, or ""
@@ -189,7 +199,7 @@ void identities(const Options& o) {
     std::printf("\n## Identities\n\n");
     // A Lambertian sphere of albedo ρ under a uniform environment L: ρ·L
     // everywhere it is seen (no hair in front of it).
-    Scene sphere = defaultScene();
+    Scene sphere = keyBackScene();
     sphere.groom.procedural.strands = 1;
     sphere.groom.procedural.headCenter = Vec3f(0.0f, 5.0f, 0.0f); // far out of view
     sphere.meshes.clear();
@@ -218,7 +228,7 @@ void identities(const Options& o) {
     const std::filesystem::path patch = o.out / "zenith_patch.exr";
     const Rgb L(2000.0f);
     writeZenithPatch(patch, L);
-    Scene hair = defaultScene();
+    Scene hair = keyBackScene();
     hair.camera.width = hair.camera.height = o.quick ? 96 : 192;
     hair.output = {};
     Scene lit = hair;
@@ -261,11 +271,11 @@ struct Variant {
 
 void design(const Options& o) {
     std::printf("\n## Dual scattering's design against the path tracer\n\n");
-    Scene base = defaultScene();
+    Scene base = keyBackScene();
     base.camera.width = base.camera.height = o.quick ? 128 : 256;
     const std::uint32_t spp = o.quick ? 32 : 256;
     constexpr int kBlock = 8;
-    std::printf("default scene at %ux%u, grid mode; error: rel. L1 of the hair's radiance over "
+    std::printf("key_back.json at %ux%u, grid mode; error: rel. L1 of the hair's radiance over "
                 "%dx%d blocks against a %u-spp path trace, its noise removed\n",
                 base.camera.width, base.camera.height, kBlock, kBlock, spp);
     {
@@ -373,10 +383,10 @@ void ratboy(const Options& o) {
 
 void noise(const Options& o) {
     std::printf("\n## The path tracer's noise under a sun\n\n");
-    Scene base = defaultScene();
+    Scene base = keyBackScene();
     base.camera.width = base.camera.height = o.quick ? 128 : 256;
     const double seconds = o.quick ? 10 : 120;
-    std::printf("default scene at %ux%u, %.0f s each; noise floor: E|I_A - I| / E|I| of the hair's "
+    std::printf("key_back.json at %ux%u, %.0f s each; noise floor: E|I_A - I| / E|I| of the hair's "
                 "radiance (per pixel, and over 8x8 blocks)\n\n",
                 base.camera.width, base.camera.height, seconds);
     double floors[2] = {0, 0};
@@ -411,10 +421,10 @@ double cpuSeconds() {
 
 void regions(const Options& o) {
     std::printf("\n## What the regions cost (dual scattering, grid mode)\n\n");
-    Scene base = defaultScene();
+    Scene base = keyBackScene();
     const std::uint32_t size = o.quick ? 512 : 1024;
     base.camera.width = base.camera.height = size;
-    std::printf("the default scene at %ux%u, in this process (CPU seconds: the machine may be "
+    std::printf("key_back.json at %ux%u, in this process (CPU seconds: the machine may be "
                 "shared); global term = the regions' preparation and lookups\n\n",
                 size, size);
     std::printf("%-34s %9s %9s %9s %9s %9s\n", "lighting", "wall s", "CPU s", "prepare", "lookups",
@@ -502,7 +512,8 @@ double median(std::vector<double> v) {
 
 void cost(const Options& o) {
     std::printf("\n## What an environment costs (dual scattering, grid mode)\n\n");
-    nlohmann::json lights = nlohmann::json::parse(std::string(defaultSceneJson()));
+    nlohmann::json lights =
+        nlohmann::json::parse(std::ifstream(kData / "scenes" / "key_back.json"));
     nlohmann::json studio = lights;
     studio["lights"] =
         nlohmann::json::array({{{"name", "studio"},
@@ -518,7 +529,7 @@ void cost(const Options& o) {
     std::ofstream(o.out / "cost_lights.json") << lights.dump(1);
     std::ofstream(o.out / "cost_studio.json") << studio.dump(1);
     const int pairs = o.quick ? 1 : 5;
-    std::printf("the default scene at %dx%d: its two directional lights, and studio.exr instead "
+    std::printf("key_back.json at %dx%d: its two directional lights, and studio.exr instead "
                 "(%u regions); %d alternating pairs of `hairvox render` (EXR and PNG written), "
                 "medians\n\n",
                 size, size, kDefaultEnvironmentLights, pairs);

@@ -12,7 +12,8 @@
 //    here directly (no filter, no own-fiber test): Embree's own rate;
 //  - RaySceneIntersect / RaySceneOccluded: the path tracer's queries, which
 //    also skip the origin's own fiber (geometry/ray_scene.h);
-//  - PathTrace512: the default scene at 512², 4 samples per pixel.
+//  - PathTrace512: the default look under its key and back lights
+//    (data/scenes/key_back.json) at 512², 4 samples per pixel.
 #include <hairvox/core/parallel.h>
 #include <hairvox/core/rng.h>
 #include <hairvox/geometry/ray_scene.h>
@@ -32,7 +33,7 @@ namespace hairvox {
 namespace {
 
 struct Fixture {
-    Scene scene = defaultScene();
+    Scene scene = loadScene(HAIRVOX_DATA_DIR "/scenes/key_back.json");
     Groom groom = generateGroom(scene.groom.procedural);
     struct Ray {
         Vec3f origin, dir;

@@ -2,6 +2,8 @@
 // (pipeline, pathtrace).
 #pragma once
 
+#include "test_util.h"
+
 #include <hairvox/core/error.h>
 #include <hairvox/core/rgb.h>
 #include <hairvox/film/film.h>
@@ -22,6 +24,17 @@ inline std::string sceneErrorOf(const nlohmann::json& j) {
         return e.what();
     }
     return "";
+}
+
+/// The default look under two directional lights, a key and a back light
+/// (data/scenes/key_back.json: the embedded default scene's groom, mannequin
+/// and camera before it was lit by an environment map), its outputs cleared:
+/// the scene the model's accuracy and speed figures are measured on.
+inline Scene keyBackScene() {
+    Scene scene = loadScene(dataDir() / "scenes" / "key_back.json");
+    scene.output.exr.clear();
+    scene.output.png.clear();
+    return scene;
 }
 
 /// The mean of the surface layer over the pixels the surfaces cover wholly (A = 1).

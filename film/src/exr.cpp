@@ -1,3 +1,5 @@
+#include "half_convert.h"
+
 #include <hairvox/core/atomic_file.h>
 #include <hairvox/core/error.h>
 #include <hairvox/core/interrupt.h>
@@ -5,8 +7,7 @@
 #include <hairvox/film/exr_codec.h>
 #include <hairvox/film/image_file.h>
 
-#include "half_convert.h"
-
+#include <openexr.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_pipeline.h>
 
@@ -15,20 +16,18 @@
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 #include <ImfStringAttribute.h>
-#include <openexr.h>
-#include <zlib.h>
-
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <bit>
 #include <cstring>
 #include <exception>
+#include <fcntl.h>
 #include <new>
 #include <span>
+#include <stdexcept>
 #include <string>
+#include <unistd.h>
 #include <vector>
+#include <zlib.h>
 
 namespace hairvox {
 
@@ -209,10 +208,14 @@ private:
 
 exr_compression_t coreCompression(ExrCompression c) {
     switch (c) {
-    case ExrCompression::Zips: return EXR_COMPRESSION_ZIPS;
-    case ExrCompression::Zip: return EXR_COMPRESSION_ZIP;
-    case ExrCompression::Rle: return EXR_COMPRESSION_RLE;
-    case ExrCompression::None: return EXR_COMPRESSION_NONE;
+    case ExrCompression::Zips:
+        return EXR_COMPRESSION_ZIPS;
+    case ExrCompression::Zip:
+        return EXR_COMPRESSION_ZIP;
+    case ExrCompression::Rle:
+        return EXR_COMPRESSION_RLE;
+    case ExrCompression::None:
+        return EXR_COMPRESSION_NONE;
     }
     throw std::logic_error("coreCompression");
 }
@@ -243,9 +246,9 @@ public:
 
     void check(exr_result_t result) const {
         if (result != EXR_ERR_SUCCESS)
-            throw InputError(strCat(path_.string(), ": cannot write OpenEXR file: ",
-                                    message_.empty() ? exr_get_default_error_message(result)
-                                                     : message_));
+            throw InputError(
+                strCat(path_.string(), ": cannot write OpenEXR file: ",
+                       message_.empty() ? exr_get_default_error_message(result) : message_));
     }
 
     /// Writes the chunk offsets and closes the file.
@@ -314,7 +317,9 @@ void writeExr(const std::filesystem::path& path, const Film& film, const ExrHead
         file.check(exr_add_part(ctx, nullptr, EXR_STORAGE_SCANLINE, &part));
         file.check(exr_initialize_required_attr_simple(ctx, part, film.width(), film.height(),
                                                        coreCompression(info.compression)));
-        const auto isLong = [](const std::string& n) { return n.size() > kShortNameLength; };
+        const auto isLong = [](const std::string& n) {
+            return n.size() > kShortNameLength;
+        };
         const bool longNames =
             std::any_of(info.attributes.begin(), info.attributes.end(),
                         [&](const auto& attribute) { return isLong(attribute.first); }) ||
@@ -438,62 +443,119 @@ bool chunksInFile(const std::filesystem::path& path) {
 
 } // namespace
 
+namespace {
+
+/// An EXR file's bytes in memory as OpenEXR's input stream (ImfIO.h): reads
+/// past the end throw, as a file's would.
+class MemoryStream final : public Imf::IStream {
+public:
+    explicit MemoryStream(const ExrSource& source)
+        : Imf::IStream(source.name.c_str())
+        , bytes_(source.bytes) {}
+
+    bool isMemoryMapped() const override { return true; }
+    bool read(char c[], int n) override {
+        std::memcpy(c, take(n), std::size_t(n));
+        return position_ < bytes_.size();
+    }
+    char* readMemoryMapped(int n) override {
+        // OpenEXR's interface is not const; it only reads what it is given.
+        return const_cast<char*>(reinterpret_cast<const char*>(take(n)));
+    }
+    std::uint64_t tellg() override { return position_; }
+    void seekg(std::uint64_t position) override { position_ = position; }
+
+private:
+    const unsigned char* take(int n) {
+        if (n < 0 || position_ > bytes_.size() || std::uint64_t(n) > bytes_.size() - position_)
+            throw std::runtime_error("unexpected end of the EXR data");
+        const unsigned char* p = bytes_.data() + position_;
+        position_ += std::uint64_t(n);
+        return p;
+    }
+
+    std::span<const unsigned char> bytes_;
+    std::uint64_t position_ = 0;
+};
+
+/// f(Imf::InputFile&) on the source's file, read with `threads` threads.
+template <class F>
+auto withInputFile(const ExrSource& source, int threads, F&& f) {
+    if (source.bytes.empty()) {
+        Imf::InputFile file(source.path.c_str(), threads);
+        return f(file);
+    }
+    MemoryStream stream(source);
+    Imf::InputFile file(stream, threads);
+    return f(file);
+}
+
+} // namespace
+
 ExrInfo readExrInfo(const std::filesystem::path& path) {
+    return readExrInfo(ExrSource::file(path));
+}
+
+ExrInfo readExrInfo(const ExrSource& source) {
     try {
-        Imf::InputFile file(path.c_str(), 1);
-        const Imf::Header& header = file.header();
-        const Imath::Box2i window = header.dataWindow();
-        ExrInfo info;
-        info.width = std::int64_t(window.max.x) - window.min.x + 1;
-        info.height = std::int64_t(window.max.y) - window.min.y + 1;
-        for (auto it = header.channels().begin(); it != header.channels().end(); ++it)
-            info.channels.emplace_back(it.name());
-        for (auto it = header.begin(); it != header.end(); ++it)
-            if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute()))
-                info.attributes[it.name()] = s->value();
-        info.complete = file.isComplete() && chunksInFile(path);
-        return info;
+        return withInputFile(source, 1, [&](Imf::InputFile& file) {
+            const Imf::Header& header = file.header();
+            const Imath::Box2i window = header.dataWindow();
+            ExrInfo info;
+            info.width = std::int64_t(window.max.x) - window.min.x + 1;
+            info.height = std::int64_t(window.max.y) - window.min.y + 1;
+            for (auto it = header.channels().begin(); it != header.channels().end(); ++it)
+                info.channels.emplace_back(it.name());
+            for (auto it = header.begin(); it != header.end(); ++it)
+                if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute()))
+                    info.attributes[it.name()] = s->value();
+            info.complete =
+                file.isComplete() && (!source.bytes.empty() || chunksInFile(source.path));
+            return info;
+        });
     } catch (const std::exception& e) {
-        throw InputError(strCat(path.string(), ": cannot read OpenEXR file: ", e.what()));
+        throw InputError(strCat(source.name, ": cannot read OpenEXR file: ", e.what()));
     }
 }
 
-ExrRgbImage readExrRgb(const std::filesystem::path& path, std::uint64_t maxPixels) {
-    ExrRgbImage image;
-    std::string channels;
+ExrRgbImage readExrRgb(const ExrSource& source, std::uint64_t maxPixels) {
     try {
-        Imf::InputFile file(path.c_str(), activeThreadCount());
-        const Imf::Header& header = file.header();
-        const Imath::Box2i window = header.dataWindow();
-        const std::int64_t width = std::int64_t(window.max.x) - window.min.x + 1;
-        const std::int64_t height = std::int64_t(window.max.y) - window.min.y + 1;
-        for (auto it = header.channels().begin(); it != header.channels().end(); ++it)
-            channels += (channels.empty() ? "" : ", ") + std::string(it.name());
-        for (const char* name : {"R", "G", "B"})
-            if (!header.channels().findChannel(name))
-                throw InputError(strCat(path.string(), ": no channel ", name,
-                                        " (an RGB or RGBA image is needed; the file has ",
-                                        channels.empty() ? std::string("none") : channels, ")"));
-        if (width < 1 || height < 1 || std::uint64_t(width) * std::uint64_t(height) > maxPixels)
-            throw InputError(strCat(path.string(), ": ", width, " x ", height,
-                                    " pixels: expected at most ", maxPixels, " pixels"));
-        image.width = int(width);
-        image.height = int(height);
-        image.rgb.assign(std::size_t(width) * std::size_t(height) * 3, 0.0f);
-        Imf::FrameBuffer frameBuffer;
-        const char* names[3] = {"R", "G", "B"};
-        for (std::size_t c = 0; c < 3; ++c)
-            frameBuffer.insert(names[c],
-                               Imf::Slice::Make(Imf::FLOAT, image.rgb.data() + c, window.min, width,
-                                                height, 3 * sizeof(float),
-                                                std::size_t(3 * width) * sizeof(float)));
-        file.setFrameBuffer(frameBuffer);
-        file.readPixels(window.min.y, window.max.y);
-        return image;
+        return withInputFile(source, activeThreadCount(), [&](Imf::InputFile& file) {
+            ExrRgbImage image;
+            std::string channels;
+            const Imf::Header& header = file.header();
+            const Imath::Box2i window = header.dataWindow();
+            const std::int64_t width = std::int64_t(window.max.x) - window.min.x + 1;
+            const std::int64_t height = std::int64_t(window.max.y) - window.min.y + 1;
+            for (auto it = header.channels().begin(); it != header.channels().end(); ++it)
+                channels += (channels.empty() ? "" : ", ") + std::string(it.name());
+            for (const char* name : {"R", "G", "B"})
+                if (!header.channels().findChannel(name))
+                    throw InputError(strCat(source.name, ": no channel ", name,
+                                            " (an RGB or RGBA image is needed; the file has ",
+                                            channels.empty() ? std::string("none") : channels,
+                                            ")"));
+            if (width < 1 || height < 1 || std::uint64_t(width) * std::uint64_t(height) > maxPixels)
+                throw InputError(strCat(source.name, ": ", width, " x ", height,
+                                        " pixels: expected at most ", maxPixels, " pixels"));
+            image.width = int(width);
+            image.height = int(height);
+            image.rgb.assign(std::size_t(width) * std::size_t(height) * 3, 0.0f);
+            Imf::FrameBuffer frameBuffer;
+            const char* names[3] = {"R", "G", "B"};
+            for (std::size_t c = 0; c < 3; ++c)
+                frameBuffer.insert(names[c],
+                                   Imf::Slice::Make(Imf::FLOAT, image.rgb.data() + c, window.min,
+                                                    width, height, 3 * sizeof(float),
+                                                    std::size_t(3 * width) * sizeof(float)));
+            file.setFrameBuffer(frameBuffer);
+            file.readPixels(window.min.y, window.max.y);
+            return image;
+        });
     } catch (const InputError&) {
         throw;
     } catch (const std::exception& e) {
-        throw InputError(strCat(path.string(), ": cannot read OpenEXR file: ", e.what()));
+        throw InputError(strCat(source.name, ": cannot read OpenEXR file: ", e.what()));
     }
 }
 

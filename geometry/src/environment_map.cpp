@@ -167,10 +167,10 @@ EnvironmentMap EnvironmentMap::uniform(const Rgb& radiance) {
                           "uniform", radiance, 0);
 }
 
-EnvironmentMap EnvironmentMap::readExr(const std::filesystem::path& path, const Rgb& scale,
+EnvironmentMap EnvironmentMap::readExr(const ExrSource& source, const Rgb& scale,
                                        float rotationDegrees, std::uint64_t maxBytes) {
-    const ExrInfo info = readExrInfo(path);
-    const std::string name = path.string();
+    const ExrInfo info = readExrInfo(source);
+    const std::string& name = source.name;
     if (info.width != 2 * info.height)
         throw InputError(strCat(name, ": ", info.width, " x ", info.height,
                                 " pixels: expected a latitude-longitude map twice as wide as "
@@ -183,7 +183,7 @@ EnvironmentMap EnvironmentMap::readExr(const std::filesystem::path& path, const 
                                 " as an environment map (", kBytesPerPixel,
                                 " bytes a pixel), over its budget of ", gibText(double(maxBytes)),
                                 "; use a smaller map (at most ", maxPixels, " pixels)"));
-    ExrRgbImage image = readExrRgb(path, maxPixels);
+    ExrRgbImage image = readExrRgb(source, maxPixels);
     std::vector<Rgb> rgb(std::size_t(image.width) * std::size_t(image.height));
     for (std::size_t p = 0; p < rgb.size(); ++p)
         rgb[p] = {image.rgb[3 * p], image.rgb[3 * p + 1], image.rgb[3 * p + 2]};
@@ -266,8 +266,7 @@ float EnvironmentMap::pdf(const Vec3f& omega) const {
     // sin θ from the components across +y: within a few cells of a pole
     // cos θ rounds to ±1 in float, while x and z keep the direction's distance
     // from it (a sample drawn there had a density of 0 read back).
-    const float sinTheta =
-        std::min(1.0f, std::sqrt(omega.x * omega.x + omega.z * omega.z));
+    const float sinTheta = std::min(1.0f, std::sqrt(omega.x * omega.x + omega.z * omega.z));
     if (!(sinTheta > 0))
         return 0;
     const Vec2f uv = coordinates(omega);

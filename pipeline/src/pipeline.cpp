@@ -182,9 +182,9 @@ MemoryEstimate estimateRenderMemory(const Scene& scene) {
             m.meshes += ec ? 0 : std::uint64_t(size) * (1 + kBytesPerTriangle / 40);
         }
     }
-    if (scene.environment && !scene.environment->file.empty()) {
+    if (scene.environment && !scene.environment->isUniform()) {
         try {
-            const ExrInfo info = readExrInfo(scene.environment->file);
+            const ExrInfo info = readExrInfo(scene.environment->source());
             m.environment = std::uint64_t(std::max<std::int64_t>(info.width, 0)) *
                             std::uint64_t(std::max<std::int64_t>(info.height, 0)) *
                             EnvironmentMap::kBytesPerPixel;

@@ -2,6 +2,7 @@
 #include "json_reader.h"
 
 #include <hairvox/core/error.h>
+#include <hairvox/geometry/builtin_environment.h>
 #include <hairvox/pipeline/scene.h>
 
 #include <nlohmann/json.hpp>
@@ -186,9 +187,8 @@ void parseFiber(JsonObject obj, Scene& scene) {
     if (absorptionKeys > 1)
         obj.fail("give one of sigma_a, melanin and color, not several");
     set("sigma_a", [&](const JsonValue& v) { f.sigma_a = v.rgb(kAny); });
-    set("color", [&](const JsonValue& v) {
-        f.sigma_a = FiberParams::sigmaFromColor(v.rgb(kAlbedo));
-    });
+    set("color",
+        [&](const JsonValue& v) { f.sigma_a = FiberParams::sigmaFromColor(v.rgb(kAlbedo)); });
     if (melanin.present()) {
         JsonObject m = melanin.object();
         const JsonValue eu = m["eumelanin"], pheo = m["pheomelanin"];
@@ -263,6 +263,16 @@ EnvironmentLight parseEnvironment(JsonObject obj, const std::filesystem::path& b
     env.name = parseLightName(obj, env.name);
     if (const JsonValue v = obj["file"]; v.present())
         env.file = scenePath(v, baseDir);
+    if (const JsonValue v = obj["builtin"]; v.present()) {
+        env.builtin = v.string();
+        if (!env.file.empty())
+            v.failExpected("either \"file\" or \"builtin\", not both");
+        try {
+            builtinEnvironment(env.builtin);
+        } catch (const InputError&) {
+            v.failExpected(strCat("one of ", builtinEnvironmentNames()));
+        }
+    }
     if (const JsonValue v = obj["color"]; v.present())
         env.color = v.rgb(kLightColor);
     if (const JsonValue v = obj["intensity"]; v.present())
@@ -327,7 +337,8 @@ MeshSource parseMesh(JsonObject obj, const std::filesystem::path& baseDir) {
     const JsonValue file = obj["file"];
     const JsonValue mannequin = obj["mannequin"];
     if (file.present() == mannequin.present())
-        obj.fail("expected exactly one of \"file\" (an OBJ mesh) and \"mannequin\" (a generated head)");
+        obj.fail(
+            "expected exactly one of \"file\" (an OBJ mesh) and \"mannequin\" (a generated head)");
     if (file.present()) {
         m.file = scenePath(file, baseDir);
     } else {
@@ -387,6 +398,14 @@ OutputSettings parseOutput(JsonObject obj, const std::string& stem) {
 }
 
 } // namespace
+
+ExrSource EnvironmentLight::source() const {
+    return builtin.empty() ? ExrSource::file(file) : builtinEnvironment(builtin).source();
+}
+
+std::string EnvironmentLight::sourceName() const {
+    return isUniform() ? std::string("uniform") : source().name;
+}
 
 void Scene::validate() const {
     if (groom.isProcedural()) {
@@ -627,7 +646,8 @@ Scene parseScene(const nlohmann::json& document, const std::string& sourceName,
             set("spp", path, [&](const JsonValue& x) {
                 pt.spp = static_cast<std::uint32_t>(x.integer(1, 1'000'000));
             });
-            set("time_limit", path, [&](const JsonValue& x) { pt.timeLimit = x.number(kTimeLimit); });
+            set("time_limit", path,
+                [&](const JsonValue& x) { pt.timeLimit = x.number(kTimeLimit); });
             const auto depth = [&](const JsonValue& x) {
                 return static_cast<std::uint32_t>(x.integer(1, 100'000));
             };
@@ -736,8 +756,7 @@ std::ostream& operator<<(std::ostream& os, const Scene& s) {
     for (const Light& l : s.lights)
         os << " " << l;
     if (s.environment)
-        os << ", environment(" << s.environment->name << ", "
-           << (s.environment->file.empty() ? std::string("uniform") : s.environment->file.string())
+        os << ", environment(" << s.environment->name << ", " << s.environment->sourceName()
            << ", color=" << s.environment->color << ", intensity=" << s.environment->intensity
            << ", rotation=" << s.environment->rotation
            << ", visible=" << (s.environment->visible ? "true" : "false") << ")";

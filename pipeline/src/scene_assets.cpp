@@ -28,12 +28,12 @@ std::shared_ptr<const EnvironmentMap> loadEnvironment(const Scene& scene, std::u
     const EnvironmentLight& e = *scene.environment;
     const Rgb scale = e.intensity * e.color;
     try {
-        if (e.file.empty()) {
+        if (e.isUniform()) {
             EnvironmentMap uniform = EnvironmentMap::uniform(scale);
             return std::make_shared<const EnvironmentMap>(std::move(uniform));
         }
         return std::make_shared<const EnvironmentMap>(
-            EnvironmentMap::readExr(e.file, scale, e.rotation, maxBytes));
+            EnvironmentMap::readExr(e.source(), scale, e.rotation, maxBytes));
     } catch (const InputError& error) {
         throw InputError(
             strCat(scene.name, ": environment light \"", e.name, "\": ", error.what()));

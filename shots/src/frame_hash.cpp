@@ -1,10 +1,12 @@
 #include <hairvox/core/error.h>
 #include <hairvox/core/version.h>
+#include <hairvox/geometry/builtin_environment.h>
 #include <hairvox/shots/frame_hash.h>
 
 #include <cerrno>
 #include <cstring>
 #include <fcntl.h>
+#include <span>
 #include <sys/stat.h>
 #include <unistd.h>
 #include <vector>
@@ -80,9 +82,9 @@ void hashSceneInto(Hasher& h, const Scene& s) {
         h.value(m.albedo);
     }
     h.value(s.environment.has_value()).value(s.environmentLights);
-    if (s.environment) { // its file's contents in frameHash()
+    if (s.environment) { // its map's contents in frameHash()
         const EnvironmentLight& e = *s.environment;
-        h.string(e.name).value(e.file.empty()).value(e.color).value(e.intensity);
+        h.string(e.name).value(e.file.empty()).string(e.builtin).value(e.color).value(e.intensity);
         h.value(e.rotation).value(e.visible);
     }
     h.value(s.voxelSize.has_value()).value(s.voxelSize.value_or(0.0f));
@@ -116,6 +118,11 @@ std::string frameHash(const Scene& scene, int frame, FileDigests& files) {
         h.value(files.of(scene.groom.file));
     if (scene.environment && !scene.environment->file.empty())
         h.value(files.of(scene.environment->file));
+    if (scene.environment && !scene.environment->builtin.empty()) {
+        const std::span<const unsigned char> exr =
+            builtinEnvironment(scene.environment->builtin).exr;
+        h.bytes(exr.data(), exr.size());
+    }
     for (const MeshSource& m : scene.meshes)
         if (!m.isMannequin())
             h.value(files.of(m.file));

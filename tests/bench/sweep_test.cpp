@@ -257,8 +257,8 @@ TEST(BenchSweep, TinySweepWritesTablesAndPlots) {
     EXPECT_EQ(host.at("simd_target").get<std::string>(), simdTarget());
     EXPECT_FALSE(host.at("cpu_model").get<std::string>().empty());
     EXPECT_GE(host.at("logical_cores").get<unsigned>(), 1u);
-    for (const char* key : {"simd_fma_flops_per_second", "dram_bytes_per_second",
-                            "miss_latency_ns", "baseline_flops_per_second"})
+    for (const char* key : {"simd_fma_flops_per_second", "dram_bytes_per_second", "miss_latency_ns",
+                            "baseline_flops_per_second"})
         EXPECT_GT(host.at(key).get<double>(), 0.0) << key;
     std::ifstream header(o.outDir / "results.md");
     std::string line;
@@ -323,9 +323,19 @@ TEST(BenchSweep, BadInputIsAnInputError) {
     o.model.frontierSpp = {};
     o.model.frontierPathsPerCell = {0.0f};
     EXPECT_THROW(o.validate(), InputError);
-    BenchScene s = sceneFile("x", "some.json");
+    // A style swap needs a procedural groom (key_back.json's), not a file's strands.
+    BenchScene s = sceneFile("x", HAIRVOX_DATA_DIR "/scenes/ratboy_mohawk.json");
     s.style = GroomStyle::Curly;
-    EXPECT_THROW(s.build(), InputError);
+    try {
+        s.build();
+        ADD_FAILURE() << "no error";
+    } catch (const InputError& e) {
+        EXPECT_TRUE(test::contains(e.what(), "x: a groom style swap applies to procedural grooms "
+                                             "only"))
+            << e.what();
+    }
+    s.file = HAIRVOX_DATA_DIR "/scenes/key_back.json";
+    EXPECT_EQ(s.build().groom.procedural.style, GroomStyle::Curly);
     const auto r = test::runHairvox("bench --runs 0");
     EXPECT_EQ(r.exitCode, 2) << r.output;
 }

@@ -3,7 +3,6 @@
 
 #include <gtest/gtest.h>
 
-
 namespace hairvox {
 namespace {
 
@@ -26,7 +25,7 @@ TEST(CliCommands, RenderDefaultSceneSmall) {
 
 TEST(CliCommands, RenderRejectsBadSceneAndOptions) {
     test::TempDir dir;
-    std::string scene = readBytes(test::dataDir() / "scenes" / "default.json");
+    std::string scene = readBytes(test::dataDir() / "scenes" / "key_back.json");
     const std::string direction = "\"direction\": [-0.2, 0.55, 0.8]";
     ASSERT_NE(scene.find(direction), std::string::npos);
     scene.replace(scene.find(direction), direction.size(), "\"direction\": \"up\"");

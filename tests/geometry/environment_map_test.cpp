@@ -7,15 +7,18 @@
 #include <hairvox/core/math.h>
 #include <hairvox/core/rng.h>
 #include <hairvox/film/image_file.h>
+#include <hairvox/geometry/builtin_environment.h>
 #include <hairvox/geometry/environment_map.h>
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -373,6 +376,38 @@ TEST(EnvironmentMap, ReadsTheShippedDwaMaps) {
     const EnvironmentMap sky =
         EnvironmentMap::readExr(test::dataDir() / "hdri" / "sky.exr", Rgb(1.0f), 0, 1u << 30);
     EXPECT_GT(sky.maxLuminance(), 5000.0f);
+}
+
+// The maps built into the program are the shipped files, byte for byte, and
+// read from memory as from disk; bad bytes in memory are an error naming the map.
+TEST(EnvironmentMap, BuiltInMapsAreTheShippedFilesReadFromMemory) {
+    ASSERT_EQ(builtinEnvironmentNames(), "studio, sky, city");
+    for (const BuiltinEnvironment& builtin : builtinEnvironments()) {
+        const std::filesystem::path file =
+            test::dataDir() / "hdri" / (std::string(builtin.name) + ".exr");
+        const std::string bytes = test::readBytes(file);
+        ASSERT_EQ(builtin.exr.size(), bytes.size()) << builtin.name;
+        EXPECT_EQ(std::memcmp(builtin.exr.data(), bytes.data(), bytes.size()), 0) << builtin.name;
+        const EnvironmentMap fromMemory =
+            EnvironmentMap::readExr(builtin.source(), Rgb(1.0f), 30.0f, 1u << 30);
+        const EnvironmentMap fromFile = EnvironmentMap::readExr(file, Rgb(1.0f), 30.0f, 1u << 30);
+        EXPECT_EQ(fromMemory.source(), "built-in map " + std::string(builtin.name));
+        EXPECT_EQ(fromMemory.width(), fromFile.width());
+        EXPECT_EQ(fromMemory.integral(), fromFile.integral()) << builtin.name;
+        EXPECT_EQ(fromMemory.pixel(300, 100), fromFile.pixel(300, 100)) << builtin.name;
+    }
+    EXPECT_TRUE(test::contains(errorOf([] { builtinEnvironment("lobby"); }),
+                               "no built-in environment map \"lobby\": expected one of studio, "
+                               "sky, city"));
+    // Cut short in memory: OpenEXR's error, named by the source, not a crash.
+    const std::span<const unsigned char> studio = builtinEnvironment("studio").exr;
+    const ExrSource cut = ExrSource::memory("half a map", studio.first(studio.size() / 2));
+    EXPECT_TRUE(
+        test::contains(errorOf([&] { EnvironmentMap::readExr(cut, Rgb(1.0f), 0, 1u << 30); }),
+                       "half a map: cannot read OpenEXR file"));
+    const ExrSource header = ExrSource::memory("a header", studio.first(40));
+    EXPECT_TRUE(test::contains(errorOf([&] { readExrInfo(header); }),
+                               "a header: cannot read OpenEXR file"));
 }
 
 } // namespace

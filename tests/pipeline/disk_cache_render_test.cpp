@@ -4,6 +4,7 @@
 // is stored follows diskCacheStoresGrid and diskCacheSkipsLights; a damaged
 // grid entry is splatted again and replaced.
 #include "film/film_bytes.h"
+#include "scene_test_util.h"
 #include "test_util.h"
 
 #include <hairvox/pipeline/pipeline.h>
@@ -18,7 +19,7 @@ namespace {
 namespace fs = std::filesystem;
 
 Scene smallScene() {
-    Scene scene = defaultScene();
+    Scene scene = test::keyBackScene();
     scene.name = "cached";
     scene.groom.procedural.strands = 600;
     scene.camera.width = scene.camera.height = 64;

@@ -6,9 +6,9 @@
 // the map's irradiance; the surfaces' shadow on the hair from several rays a
 // region; the options' ranges; the backdrop; determinism and frame reuse.
 #include "../../pipeline/src/environment_lights.h"
-#include "scene_test_util.h"
 #include "../transmittance/slab.h"
 #include "film/film_bytes.h"
+#include "scene_test_util.h"
 #include "test_util.h"
 
 #include <hairvox/core/error.h>
@@ -57,10 +57,17 @@ TEST(SceneEnvironment, KeysParse) {
     j["lights"][1] = {{"type", "environment"}, {"color", {0.2, 0.3, 0.4}}};
     j["dual_scattering"] = {{"environment_lights", 32}};
     const Scene u = parseScene(j, "scene.json", "/scenes");
-    EXPECT_TRUE(u.environment->file.empty());
+    EXPECT_TRUE(u.environment->isUniform());
+    EXPECT_EQ(u.environment->sourceName(), "uniform");
     EXPECT_EQ(u.environment->name, "environment");
     EXPECT_TRUE(u.environment->visible);
     EXPECT_EQ(u.environmentLights, 32u);
+    // A built-in map by name.
+    j["lights"][1] = {{"type", "environment"}, {"builtin", "sky"}};
+    const Scene b = parseScene(j, "scene.json", "/scenes");
+    EXPECT_EQ(b.environment->builtin, "sky");
+    EXPECT_FALSE(b.environment->isUniform());
+    EXPECT_EQ(b.environment->sourceName(), "built-in map sky");
 }
 
 TEST(SceneEnvironment, BadKeysNameTheirPath) {
@@ -76,9 +83,19 @@ TEST(SceneEnvironment, BadKeysNameTheirPath) {
     j = environmentScene();
     j["lights"][1]["samples"] = 4;
     EXPECT_TRUE(test::contains(errorOf(j), "/lights/1/samples: unknown key (valid keys in "
-                                           "/lights/1: type, name, file, color, intensity, "
-                                           "rotation, visible)"))
+                                           "/lights/1: type, name, file, builtin, color, "
+                                           "intensity, rotation, visible)"))
         << errorOf(j);
+    j = environmentScene();
+    j["lights"][1]["builtin"] = "studio";
+    EXPECT_EQ(errorOf(j), "scene.json: /lights/1/builtin: expected either \"file\" or "
+                          "\"builtin\", not both, got \"studio\"");
+    j["lights"][1].erase("file");
+    j["lights"][1]["builtin"] = "lobby";
+    EXPECT_EQ(errorOf(j), "scene.json: /lights/1/builtin: expected one of studio, sky, city, "
+                          "got \"lobby\"");
+    j["lights"][1]["builtin"] = 3;
+    EXPECT_TRUE(test::contains(errorOf(j), "/lights/1/builtin: expected")) << errorOf(j);
     j = environmentScene();
     j["lights"][1]["visible"] = "yes";
     EXPECT_TRUE(test::contains(errorOf(j), "/lights/1/visible: expected")) << errorOf(j);
@@ -113,6 +130,32 @@ PipelineOptions options(const test::TempDir& dir) {
     PipelineOptions o;
     o.tableCacheDir = dir / "cache";
     return o;
+}
+
+// The embedded default scene is lit by the built-in studio map: no pixel of
+// the hair or the mannequin is black (under the two directional lights of
+// key_back.json the neck in the head's shadow is 0), and the backdrop is the map.
+TEST(PipelineEnvironment, TheDefaultSceneLeavesNothingBlack) {
+    test::TempDir dir;
+    for (const bool environmentLit : {true, false}) {
+        Scene scene = environmentLit ? defaultScene() : test::keyBackScene();
+        scene.groom.procedural.strands = 5000;
+        scene.camera.width = scene.camera.height = 64;
+        scene.output = {};
+        const Film film = renderScene(scene, options(dir), false).film;
+        std::size_t covered = 0, black = 0;
+        for (std::size_t p = 0; p < film.pixelCount(); ++p) {
+            if (film.layer(Film::kAlpha).scalar(p) < 0.999f)
+                continue;
+            ++covered;
+            black += film.beauty(p).luminance() <= 0.0f;
+        }
+        ASSERT_GT(covered, 300u);
+        if (environmentLit)
+            EXPECT_EQ(black, 0u) << "of " << covered << " covered pixels";
+        else
+            EXPECT_GT(black, 0u) << "the directional lights leave a shadow black";
+    }
 }
 
 TEST(PipelineEnvironment, AMissingMapIsAnErrorNamingTheLightAndTheFile) {

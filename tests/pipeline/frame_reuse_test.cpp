@@ -2,6 +2,7 @@
 // FrameReuse): what is reused follows what changed between the frames, and
 // every frame is the same bytes as rendered alone.
 #include "film/film_bytes.h"
+#include "scene_test_util.h"
 #include "test_util.h"
 
 #include <hairvox/pipeline/pipeline.h>
@@ -18,7 +19,7 @@ namespace {
 
 /// The default scene, small (600 strands at 64²), its groom in a file of `dir`.
 Scene fileScene(const test::TempDir& dir) {
-    Scene scene = defaultScene();
+    Scene scene = test::keyBackScene();
     scene.name = "frame";
     scene.groom.procedural.strands = 600;
     scene.groom.file = dir / "groom.hair";

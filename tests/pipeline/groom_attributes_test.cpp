@@ -2,6 +2,7 @@
 // read as per-point diameters, colours mapped to σ_a as fiber types, and a
 // groom whose strands differ in colour rendered with those colours by every
 // global-term mode and by the path tracer.
+#include "scene_test_util.h"
 #include "test_util.h"
 
 #include <hairvox/core/error.h>
@@ -181,7 +182,7 @@ Scene twoToneScene(const test::TempDir& dir, const Rgb& left, const Rgb& right) 
                 groom.addStrand(line);
                 groom.color.insert(groom.color.end(), 6, side == 0 ? left : right);
             }
-    Scene scene = defaultScene();
+    Scene scene = test::keyBackScene();
     scene.name = "two-tone";
     scene.groom.file = dir / "two_tone.hair";
     writeHairFile(scene.groom.file, groom);

@@ -3,6 +3,7 @@
 // read from a file, is sanitized like a file's, is counted by the memory
 // estimate, keys FrameReuse by its content and is never changed by a render.
 #include "film/film_bytes.h"
+#include "scene_test_util.h"
 #include "test_util.h"
 
 #include <hairvox/core/error.h>
@@ -38,7 +39,7 @@ Groom attributedGroom() {
 
 /// The default scene at 64², its head a sphere instead of the mannequin mesh.
 Scene smallScene(const std::string& name) {
-    Scene scene = defaultScene();
+    Scene scene = test::keyBackScene();
     scene.name = name;
     scene.meshes.clear();
     scene.head = Head{};

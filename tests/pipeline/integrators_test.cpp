@@ -6,6 +6,7 @@
 // reference's resolution its one shading point per fragment and its
 // compositing of a pixel's partly covering strands as if independent are what
 // differ, not the light transport (docs/DESIGN.md §8).
+#include "scene_test_util.h"
 #include "test_util.h"
 
 #include <hairvox/core/math.h>
@@ -81,7 +82,7 @@ Depth1 compareDepth1(Scene scene, const test::TempDir& dir, std::uint32_t spp, i
 }
 
 Scene smallDefault() {
-    Scene scene = defaultScene();
+    Scene scene = test::keyBackScene();
     scene.groom.procedural.strands = 1500; // k = 3: ribbons 3·D wide
     scene.camera.width = scene.camera.height = 96;
     return scene;
@@ -152,7 +153,7 @@ TEST(IntegratorsSlow, DepthOneOnTheBearAt160WithDensityMultiplier8) {
 }
 
 TEST(IntegratorsSlow, DepthOneOnTheDefaultSceneAt160) {
-    Scene scene = defaultScene();
+    Scene scene = test::keyBackScene();
     scene.camera.width = scene.camera.height = 160;
     expectDepth1Within2Percent("default scene", scene, 4);
 }

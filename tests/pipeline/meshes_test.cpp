@@ -2,6 +2,7 @@
 // hair behind it (rasterizer and path tracer), blocks light in every
 // global-term mode, receives the hair's shadow, and the Ratboy scene renders
 // its mohawk on its body.
+#include "scene_test_util.h"
 #include "test_util.h"
 
 #include <hairvox/core/error.h>
@@ -40,7 +41,7 @@ std::string rectangleObj(float y, float x0, float x1, float z0, float z1) {
 
 /// The slab lit from above, seen from the front (+z), no head.
 Scene slabScene(const test::TempDir& dir, GlobalTermMode mode) {
-    Scene scene = defaultScene();
+    Scene scene = test::keyBackScene();
     scene.name = "slab";
     scene.groom.file = dir / "slab.hair";
     writeHairFile(scene.groom.file, strandSlab());

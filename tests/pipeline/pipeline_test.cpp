@@ -3,6 +3,7 @@
 // shader evaluated directly, light and shadow cases, the head, determinism and
 // the reference image.
 #include "film/film_bytes.h"
+#include "scene_test_util.h"
 #include "test_util.h"
 
 #include <hairvox/core/math.h>
@@ -22,7 +23,7 @@ namespace {
 
 /// The default scene, small: 800 strands at 96², writing into `dir`.
 Scene smallScene(const test::TempDir& dir, GlobalTermMode mode = GlobalTermMode::Grid) {
-    Scene scene = defaultScene();
+    Scene scene = test::keyBackScene();
     scene.name = "small";
     scene.groom.procedural.strands = 800;
     scene.camera.width = scene.camera.height = 96;

@@ -1,5 +1,5 @@
-#include "test_util.h"
 #include "scene_test_util.h"
+#include "test_util.h"
 
 #include <hairvox/core/error.h>
 #include <hairvox/pipeline/scene.h>
@@ -72,12 +72,8 @@ TEST(Scene, EveryFeatureParses) {
                         {"exact", {{"rays", 8}, {"radius", 0.001}, {"seed", 5}}}};
     j["shading_rate"] = "vertex";
     j["background"] = {0.1, 0.1, 0.1};
-    j["output"] = {{"exr", "a/b.exr"},
-                   {"png", nullptr},
-                   {"exposure", 1.5},
-                   {"tone_map", "clamp"},
-                   {"exr_zip_level", 6},
-                   {"exr_compression", "rle"}};
+    j["output"] = {{"exr", "a/b.exr"},    {"png", nullptr},     {"exposure", 1.5},
+                   {"tone_map", "clamp"}, {"exr_zip_level", 6}, {"exr_compression", "rle"}};
     const Scene s = parseScene(j, "scene.json", "/scenes");
     EXPECT_EQ(s.groom.file, std::filesystem::path("/scenes/grooms/a.hair"));
     EXPECT_FLOAT_EQ(s.fiberScale.diameter, 8e-5f);
@@ -160,8 +156,7 @@ TEST(Scene, ShadingToleranceBelongsToTheAdaptiveRate) {
 
 TEST(Scene, TailTransmittanceBelongsToTheFragmentAndAdaptiveRates) {
     nlohmann::json j = validScene();
-    EXPECT_FLOAT_EQ(parseScene(j, "scene.json", "/").tailTransmittance,
-                    kDefaultTailTransmittance);
+    EXPECT_FLOAT_EQ(parseScene(j, "scene.json", "/").tailTransmittance, kDefaultTailTransmittance);
     j["tail_transmittance"] = 0;
     EXPECT_FLOAT_EQ(parseScene(j, "scene.json", "/").tailTransmittance, 0.0f);
     j["shading_rate"] = "adaptive";
@@ -425,11 +420,13 @@ TEST(Scene, MeshesAreReadAndCheckedFieldByField) {
               "scene.json: /meshes/0: expected exactly one of \"file\" (an OBJ mesh) and "
               "\"mannequin\" (a generated head)");
     EXPECT_EQ(errorWith(R"({"file": 3})"), "scene.json: /meshes/0/file: expected a string, got 3");
-    EXPECT_NE(errorWith(R"({"file": "a.obj", "transform": {"scale": 0}})").find("/meshes/0/transform/scale"),
+    EXPECT_NE(errorWith(R"({"file": "a.obj", "transform": {"scale": 0}})")
+                  .find("/meshes/0/transform/scale"),
               std::string::npos);
     EXPECT_NE(errorWith(R"({"mannequin": {"rings": 4}})").find("/meshes/0/mannequin/rings"),
               std::string::npos);
-    EXPECT_NE(errorWith(R"({"file": "a.obj", "colour": [1, 1, 1]})").find("colour"), std::string::npos);
+    EXPECT_NE(errorWith(R"({"file": "a.obj", "colour": [1, 1, 1]})").find("colour"),
+              std::string::npos);
     EXPECT_NE(errorWith(R"({"file": "a.obj", "color": [2, 0, 0]})").find("/meshes/0/color"),
               std::string::npos);
 }
@@ -477,12 +474,27 @@ TEST(Scene, DefaultSceneIsTheShowcase) {
     EXPECT_TRUE(s.meshes[0].isMannequin());
     EXPECT_EQ(s.meshes[0].mannequin.center, s.groom.procedural.headCenter);
     EXPECT_EQ(s.meshes[0].mannequin.radius, s.groom.procedural.headRadius);
-    EXPECT_GE(s.lights.size(), 2u);
+    // Lit as look development starts (issue 37): a built-in studio map, seen
+    // behind the groom, and no other light.
+    EXPECT_TRUE(s.lights.empty());
+    ASSERT_TRUE(s.environment.has_value());
+    EXPECT_EQ(s.environment->builtin, "studio");
+    EXPECT_TRUE(s.environment->visible);
     EXPECT_EQ(s.camera.width, 1024u);
     EXPECT_EQ(s.camera.height, 1024u);
     EXPECT_EQ(s.globalTermMode, GlobalTermMode::Grid);
     EXPECT_EQ(s.output.exr, std::filesystem::path("out/default.exr"));
     EXPECT_EQ(s.output.png, std::filesystem::path("out/default.png"));
+}
+
+TEST(Scene, TheKeyAndBackSceneIsTheDefaultLookUnderTwoLights) {
+    const Scene s = test::keyBackScene();
+    const Scene d = defaultScene();
+    EXPECT_EQ(s.groom.procedural.strands, d.groom.procedural.strands);
+    EXPECT_EQ(s.fiber.sigma_a, d.fiber.sigma_a);
+    EXPECT_EQ(s.camera.position, d.camera.position);
+    EXPECT_FALSE(s.environment.has_value());
+    ASSERT_EQ(s.lights.size(), 2u);
     // A back light: it shines from behind the hair toward the camera.
     bool backLit = false;
     for (const Light& l : s.lights)

@@ -18,7 +18,7 @@ namespace hairvox {
 namespace {
 
 Scene smallVolumetric(std::uint32_t strands = 1500, std::uint32_t size = 64) {
-    Scene scene = defaultScene();
+    Scene scene = test::keyBackScene();
     scene.groom.procedural.strands = strands;
     scene.camera.width = scene.camera.height = size;
     scene.integrator = Integrator::Volumetric;

@@ -66,9 +66,9 @@ std::vector<std::filesystem::path> writeSweepOutputs(const SweepOptions& o, Swee
 } // namespace
 
 Scene BenchScene::build() const {
-    if (style && !file.empty())
-        throw InputError(strCat(label, ": a groom style swap applies to the default scene only"));
     Scene scene = file.empty() ? defaultScene() : loadScene(file);
+    if (style && !scene.groom.isProcedural())
+        throw InputError(strCat(label, ": a groom style swap applies to procedural grooms only"));
     if (style) {
         scene.groom.procedural.style = *style;
         scene.groom.procedural.pointsPerStrand = pointsPerStrand;
@@ -161,8 +161,8 @@ std::optional<PowerLawFit> fitPowerLaw(std::span<const double> x, std::span<cons
 
 namespace {
 
-/// The model sweep's scenes: the default scene, the curly close-up and Ratboy
-/// at `size` pixels wide (the scenes' own aspect).
+/// The model sweep's scenes: the default look under its key and back lights,
+/// the curly close-up and Ratboy at `size` pixels wide (the scenes' own aspect).
 std::vector<BenchScene> modelScenes(const std::filesystem::path& scenesDir, std::uint32_t size,
                                     bool withRatboy) {
     std::vector<BenchScene> scenes;
@@ -173,7 +173,7 @@ std::vector<BenchScene> modelScenes(const std::filesystem::path& scenesDir, std:
         // A missing file is named by validate(), before any work starts.
         scenes.push_back(std::filesystem::exists(s.file) || s.file.empty() ? s.atWidth(size) : s);
     };
-    add("wavy (default scene)", {});
+    add("wavy (key + back)", scenesDir / "key_back.json");
     add("curly close-up", scenesDir / "curly_closeup.json");
     if (withRatboy)
         add("Ratboy mohawk", scenesDir / "ratboy_mohawk.json");
@@ -198,19 +198,23 @@ std::vector<BenchScene> voxelScenes(const BenchScene& scene, std::initializer_li
 SweepOptions SweepOptions::full(const std::filesystem::path& scenesDir) {
     SweepOptions o;
     const std::filesystem::path ratboyScene = scenesDir / "ratboy_mohawk.json";
-    const auto style = [](const char* label, GroomStyle s) {
+    const std::filesystem::path keyBack = scenesDir / "key_back.json";
+    const auto style = [&](const char* label, GroomStyle s) {
         BenchScene b;
         b.label = label;
+        b.file = keyBack;
         b.style = s;
         return b;
     };
     BenchScene wavy;
-    wavy.label = "wavy (default scene)";
+    wavy.label = "wavy (key + back)";
+    wavy.file = keyBack;
     BenchScene ratboy;
     ratboy.label = "Ratboy mohawk";
     ratboy.file = ratboyScene;
     BenchScene head;
     head.label = "wavy head 1.4M";
+    head.file = keyBack;
     head.strands = 50000;
     head.pointsPerStrand = 29;
     head.width = 1920;
@@ -236,7 +240,8 @@ SweepOptions SweepOptions::full(const std::filesystem::path& scenesDir) {
     }
     for (const std::uint32_t size : {256u, 512u, 1024u, 2048u}) {
         BenchScene s;
-        s.label = strCat("default scene ", size, "^2");
+        s.label = strCat("key + back ", size, "^2");
+        s.file = keyBack;
         s.width = s.height = size;
         o.pixelScaling.push_back(s);
     }
@@ -253,8 +258,10 @@ SweepOptions SweepOptions::full(const std::filesystem::path& scenesDir) {
 
 SweepOptions SweepOptions::quick(const std::filesystem::path& scenesDir) {
     SweepOptions o;
+    const std::filesystem::path keyBack = scenesDir / "key_back.json";
     BenchScene wavy;
-    wavy.label = "wavy (default scene) 512^2";
+    wavy.label = "wavy (key + back) 512^2";
+    wavy.file = keyBack;
     wavy.width = wavy.height = 512;
     BenchScene curly = wavy;
     curly.label = "curly 512^2";
@@ -269,6 +276,7 @@ SweepOptions SweepOptions::quick(const std::filesystem::path& scenesDir) {
     for (const std::uint32_t strands : {357u, 3571u, 14286u}) {
         BenchScene s;
         s.label = strCat("wavy ", strands, " strands");
+        s.file = keyBack;
         s.strands = strands;
         s.pointsPerStrand = 29;
         s.width = 960;
@@ -277,7 +285,8 @@ SweepOptions SweepOptions::quick(const std::filesystem::path& scenesDir) {
     }
     for (const std::uint32_t size : {256u, 512u, 1024u}) {
         BenchScene s;
-        s.label = strCat("default scene ", size, "^2");
+        s.label = strCat("key + back ", size, "^2");
+        s.file = keyBack;
         s.width = s.height = size;
         o.pixelScaling.push_back(s);
     }

@@ -20,6 +20,7 @@
 #include <filesystem>
 #include <map>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -90,14 +91,30 @@ ExrImage readExr(const std::filesystem::path& path);
 /// the data window is in the file (OpenEXR's isComplete(): false for a file
 /// cut short).
 struct ExrInfo {
-    std::int64_t width = 0, height = 0;         ///< of the data window
-    std::vector<std::string> channels;          ///< their names, in the file's order
+    std::int64_t width = 0, height = 0; ///< of the data window
+    std::vector<std::string> channels;  ///< their names, in the file's order
     std::map<std::string, std::string> attributes;
     bool complete = false;
 };
 
+/// Where an EXR is read from: a file, or an EXR file's bytes in memory (a map
+/// built into the program), with the name messages give it.
+struct ExrSource {
+    std::filesystem::path path;           ///< read when `bytes` is empty
+    std::span<const unsigned char> bytes; ///< a whole EXR file, outliving the reads
+    std::string name;                     ///< what messages call it
+
+    static ExrSource file(const std::filesystem::path& path) { return {path, {}, path.string()}; }
+    static ExrSource memory(std::string name, std::span<const unsigned char> bytes) {
+        return {{}, bytes, std::move(name)};
+    }
+};
+
 /// Throws InputError naming the file if it is not a readable EXR.
 ExrInfo readExrInfo(const std::filesystem::path& path);
+/// The same of a source in memory or on disk (in memory: complete when
+/// OpenEXR's offset table says so).
+ExrInfo readExrInfo(const ExrSource& source);
 
 /// An EXR's colour: its R, G and B channels as floats.
 struct ExrRgbImage {
@@ -111,7 +128,7 @@ struct ExrRgbImage {
 /// header first: InputError naming the file if it cannot be read, lacks one
 /// of R, G, B (the message lists its channels) or holds more than maxPixels
 /// pixels (nothing is allocated for it then).
-ExrRgbImage readExrRgb(const std::filesystem::path& path, std::uint64_t maxPixels);
+ExrRgbImage readExrRgb(const ExrSource& source, std::uint64_t maxPixels);
 
 /// The film an EXR image holds: channels R, G, B as the beauty layer "",
 /// X.R, X.G, X.B as the RGB layer X, any other channel as a scalar layer of its

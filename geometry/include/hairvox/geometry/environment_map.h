@@ -58,6 +58,7 @@
 #include <hairvox/core/hash.h>
 #include <hairvox/core/rgb.h>
 #include <hairvox/core/vecmath.h>
+#include <hairvox/film/image_file.h>
 
 #include <cstdint>
 #include <filesystem>
@@ -134,13 +135,17 @@ public:
                    const Rgb& scale = Rgb(1.0f), float rotationDegrees = 0);
     /// The same radiance from every direction.
     static EnvironmentMap uniform(const Rgb& radiance);
-    /// Reads an EXR file (film/image_file.h readExrRgb: RGB or RGBA, half or
+    /// Reads an EXR, a file or a built-in map (film/image_file.h readExrRgb: RGB or RGBA, half or
     /// float, any compression). InputError naming the file: unreadable, not
     /// RGB, not 2:1, non-finite pixels or negative ones that cannot be
     /// folded, or more pixels than `maxBytes` allows at kBytesPerPixel
     /// (checked from its header, before reading).
+    static EnvironmentMap readExr(const ExrSource& source, const Rgb& scale, float rotationDegrees,
+                                  std::uint64_t maxBytes);
     static EnvironmentMap readExr(const std::filesystem::path& path, const Rgb& scale,
-                                  float rotationDegrees, std::uint64_t maxBytes);
+                                  float rotationDegrees, std::uint64_t maxBytes) {
+        return readExr(ExrSource::file(path), scale, rotationDegrees, maxBytes);
+    }
 
     /// Radiance arriving from the unit world direction ω (what lights).
     Rgb radiance(const Vec3f& omega) const;

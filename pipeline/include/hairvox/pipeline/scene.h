@@ -91,18 +91,28 @@ struct MeshSource {
 
 /// The environment light (docs/scene.md "Environment light"): radiance from
 /// every direction, color × intensity × a latitude–longitude map (or × 1
-/// without a file), turned by `rotation` about +y (geometry/environment_map.h
+/// without a map), turned by `rotation` about +y (geometry/environment_map.h
 /// has the layout). At most one per scene.
 struct EnvironmentLight {
     std::string name = "environment"; ///< as a light's (unique among the lights)
-    /// An RGB(A) EXR, resolved against the scene file's directory; empty: uniform.
+    /// An RGB(A) EXR, resolved against the scene file's directory.
     std::filesystem::path file;
+    /// Or a map built into the program (geometry/builtin_environment.h):
+    /// "studio", "sky", "city". Neither: uniform.
+    std::string builtin;
     Rgb color{1.0f};        ///< each channel in [0, 1000]
     float intensity = 1.0f; ///< [0, 1e6]
     float rotation = 0;     ///< degrees about +y, right-handed, [-360, 360]
     /// The camera sees it behind everything, in the beauty and the background
     /// layer (instead of Scene::background). Either way it lights the scene.
     bool visible = true;
+
+    bool isUniform() const { return file.empty() && builtin.empty(); }
+    /// Where its map is read from (a file or a built-in map's bytes); not for a
+    /// uniform environment.
+    ExrSource source() const;
+    /// What the report calls the map: the file, "built-in map studio" or "uniform".
+    std::string sourceName() const;
 };
 
 /// Scene::environmentLights unless a scene says otherwise (docs/environment.md).
@@ -171,7 +181,7 @@ struct Scene {
     /// approx modes, GridOptions::fiberSampleSpacing); nullopt: the default.
     std::optional<float> fiberSampleSpacing;
     Integrator integrator = Integrator::DualScattering;
-    PathTraceSettings pathTrace; ///< the path integrator's spp, time limit, depth and seed
+    PathTraceSettings pathTrace;   ///< the path integrator's spp, time limit, depth and seed
     VolumetricSettings volumetric; ///< the volumetric integrator's paths, cache and seed
     GlobalTermMode globalTermMode = GlobalTermMode::Grid;
     ExactSettings exact;

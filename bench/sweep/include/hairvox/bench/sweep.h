@@ -92,12 +92,14 @@
 
 namespace hairvox {
 
-/// A scene of the sweep: a scene file, or the embedded default scene (with its
-/// procedural groom's style swapped when `style` is set), then overrides.
+/// A scene of the sweep: a scene file, or the embedded default scene (a
+/// procedural groom's style swapped when `style` is set), then overrides. The
+/// sweeps of full() and quick() start from data/scenes/key_back.json, the
+/// default look under its two directional lights.
 struct BenchScene {
     std::string label;               ///< names the scene in tables and plots
     std::filesystem::path file;      ///< scene JSON; empty: defaultScene()
-    std::optional<GroomStyle> style; ///< default scene only: replaces the groom's style
+    std::optional<GroomStyle> style; ///< procedural grooms only: replaces the groom's style
     std::uint32_t strands = 0;       ///< procedural grooms: strand count; 0: the scene's
     /// Procedural grooms: points per strand; 0: the scene's, or the style's
     /// default when `style` swaps it.
