@@ -18,7 +18,8 @@ namespace {
 namespace fs = std::filesystem;
 
 TEST(ShotsFrameHash, FollowsWhatTheImagesAreMadeOf) {
-    const Scene base = defaultScene();
+    // The two-light look with its outputs (which outputs are part of a frame).
+    const Scene base = loadScene(test::dataDir() / "scenes" / "key_back.json");
     FileDigests files;
     const std::string h = frameHash(base, 1, files);
     EXPECT_EQ(h.size(), 16u);
@@ -45,6 +46,17 @@ TEST(ShotsFrameHash, FollowsWhatTheImagesAreMadeOf) {
     changes("no PNG", [](Scene& s) { s.output.png.clear(); });
     changes("the compression", [](Scene& s) { s.output.exrCompression = ExrCompression::Zips; });
     changes("the integrator", [](Scene& s) { s.integrator = Integrator::Path; });
+    changes("an environment", [](Scene& s) { s.environment = defaultScene().environment; });
+
+    // The default scene's built-in map: which one, and how it is turned.
+    const Scene lit = defaultScene();
+    const std::string studio = frameHash(lit, 1, files);
+    Scene sky = lit;
+    sky.environment->builtin = "sky";
+    EXPECT_NE(frameHash(sky, 1, files), studio) << "the built-in map";
+    Scene turned = lit;
+    turned.environment->rotation += 1;
+    EXPECT_NE(frameHash(turned, 1, files), studio) << "the map's rotation";
 
     const auto keeps = [&](const char* what, const std::function<void(Scene&)>& edit) {
         Scene s = base;
@@ -87,7 +99,7 @@ TEST(ShotsFrameHash, FilesCountByContentNotByNameOrPlace) {
 // of them changes size (x86-64, GCC): add the field to hashSceneInto
 // (shots/src/frame_hash.cpp), then the new size here.
 TEST(ShotsFrameHash, CoversEveryFieldOfTheScene) {
-    EXPECT_EQ(sizeof(Scene), 784u);
+    EXPECT_EQ(sizeof(Scene), 816u);
     EXPECT_EQ(sizeof(GroomSource), 160u);
     EXPECT_EQ(sizeof(ProceduralGroomParams), 96u);
     EXPECT_EQ(sizeof(CameraParams), 48u);
@@ -97,7 +109,7 @@ TEST(ShotsFrameHash, CoversEveryFieldOfTheScene) {
     EXPECT_EQ(sizeof(ExactSettings), 16u);
     EXPECT_EQ(sizeof(PathTraceSettings), 40u);
     EXPECT_EQ(sizeof(OutputSettings), 128u);
-    EXPECT_EQ(sizeof(EnvironmentLight), 96u);
+    EXPECT_EQ(sizeof(EnvironmentLight), 128u);
     EXPECT_EQ(sizeof(VolumetricSettings), 56u); // (VolumetricSettings::hashInto)
 }
 
