@@ -26,17 +26,6 @@ bool isConvexQuad(const Vec2d q[4]) {
     return !(positive && negative);
 }
 
-void ScreenRibbon::locate(const Vec2d& c, float& t, float& depth) const {
-    const Vec2d d = s1 - s0;
-    const double len2 = glm::dot(d, d);
-    const double ts = len2 > 1e-18 ? std::clamp(glm::dot(c - s0, d) / len2, 0.0, 1.0) : 0.5;
-    // 1/z is affine in raster space; the 3D parameter is perspective-correct.
-    const double invZ = (1.0 - ts) * double(invZ0) + ts * double(invZ1);
-    const double tw = ts * double(invZ1) / invZ;
-    depth = static_cast<float>(1.0 / invZ);
-    t = static_cast<float>((1.0 - tw) * double(t0) + tw * double(t1));
-}
-
 namespace {
 
 /// The ribbon's half-width offset at a vertex: the projection of the radius

@@ -56,10 +56,40 @@ struct ScreenRibbon {
                std::isfinite(yMax) && std::isfinite(invZ0) && std::isfinite(invZ1) && invZ0 > 0 &&
                invZ1 > 0;
     }
+};
 
-    /// Where the pixel centre `c` falls along the ribbon: the parameter on the
-    /// original segment (perspective-correct) and the depth there.
-    void locate(const Vec2d& c, float& t, float& depth) const;
+/// Where a pixel centre falls along a ribbon: the parameter on the original
+/// segment (perspective-correct) and the depth there. Made once per ribbon
+/// (its axis scaled by 1/|axis|², so that a fragment divides once, for its
+/// depth: three double divisions in a row were the raster's longest chain),
+/// asked once per fragment.
+class RibbonLocator {
+public:
+    explicit RibbonLocator(const ScreenRibbon& r)
+        : s0_(r.s0)
+        , invZ0_(r.invZ0)
+        , invZ1_(r.invZ1)
+        , t0_(r.t0)
+        , t1_(r.t1) {
+        const Vec2d d = r.s1 - r.s0;
+        const double len2 = glm::dot(d, d);
+        degenerate_ = !(len2 > 1e-18);
+        axis_ = degenerate_ ? Vec2d(0.0) : d / len2;
+    }
+
+    void locate(const Vec2d& c, float& t, float& depth) const {
+        const double ts = degenerate_ ? 0.5 : std::clamp(glm::dot(c - s0_, axis_), 0.0, 1.0);
+        // 1/z is affine in raster space; the 3D parameter is perspective-correct.
+        const double z = 1.0 / ((1.0 - ts) * invZ0_ + ts * invZ1_);
+        const double tw = ts * invZ1_ * z;
+        depth = static_cast<float>(z);
+        t = static_cast<float>((1.0 - tw) * t0_ + tw * t1_);
+    }
+
+private:
+    Vec2d s0_, axis_;
+    double invZ0_, invZ1_, t0_, t1_;
+    bool degenerate_;
 };
 
 /// A strand vertex seen by the camera: what the ribbons of its two segments

@@ -140,11 +140,12 @@ void TileRenderer::rasterizeAndComposite() {
                 ++result_.segmentsSkipped;
                 continue;
             }
+            const RibbonLocator locator(r);
             raster::rasterizeRibbon(
                 r, x0_, y0_, x1_, y1_, s_.coverageCells,
                 [&](int x, int y, float coverage) {
                     Fragment f;
-                    r.locate(Vec2d(x + 0.5, y + 0.5), f.t, f.depth);
+                    locator.locate(Vec2d(x + 0.5, y + 0.5), f.t, f.depth);
                     f.alpha = coverage;
                     f.local = local;
                     f.pixel = pixelIndex(x, y);

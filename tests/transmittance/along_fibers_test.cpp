@@ -130,6 +130,41 @@ TEST(AlongFibers, AQueryGetsTheSameBitsInAnyBatch) {
     }
 }
 
+TEST(AlongFibers, ConsecutiveSegmentsShareTheirVertexWithTheSameBits) {
+    // Queries along segments 0 and 1 of a strand, in order, then segment 3
+    // of the other strand: with shared vertices the sample at point 1 (the
+    // end of segment 0's run, the start of segment 1's) is evaluated once,
+    // and every query gets the same bits as without sharing, since the
+    // samples at t = 0 and 1 are the vertices themselves.
+    Fixture f; // its queries come segment by segment
+    // A query at each end of both long segments, so that the runs meet at
+    // the vertex between them.
+    for (std::uint32_t segment : {0u, 1u})
+        for (float t : {0.0f, 1.0f}) {
+            const Vec3f p0 = f.groom.points[segment], p1 = f.groom.points[segment + 1];
+            GlobalTermQuery q{t == 1.0f ? p1 : p0, glm::normalize(p1 - p0), 0u, true, 0, segment};
+            const auto at =
+                std::find_if(f.queries.begin(), f.queries.end(),
+                             [&](const GlobalTermQuery& o) { return o.segment > segment; });
+            f.queries.insert(at, q);
+        }
+    auto separateInner = std::make_unique<FieldGlobalTerm>();
+    auto sharedInner = std::make_unique<FieldGlobalTerm>();
+    const FieldGlobalTerm& separateField = *separateInner;
+    const FieldGlobalTerm& sharedField = *sharedInner;
+    const auto separate = alongFibers(std::move(separateInner), f.groom, 0.01f, false);
+    const auto shared = alongFibers(std::move(sharedInner), f.groom, 0.01f, true);
+    std::vector<GlobalTerm> a(f.queries.size()), b(f.queries.size());
+    separate->evaluate(f.queries, a);
+    shared->evaluate(f.queries, b);
+    EXPECT_EQ(sharedField.evaluated + 1, separateField.evaluated);
+    for (std::size_t i = 0; i < f.queries.size(); ++i) {
+        EXPECT_EQ(bitsOf(a[i].n), bitsOf(b[i].n)) << "query " << i;
+        EXPECT_EQ(bitsOf(a[i].V), bitsOf(b[i].V)) << "query " << i;
+        EXPECT_EQ(bitsOf(a[i].sigma2_f.g), bitsOf(b[i].sigma2_f.g)) << "query " << i;
+    }
+}
+
 TEST(AlongFibers, PointsOffTheFibersAreEvaluatedAsTheyAre) {
     const Fixture f;
     const auto sampled = alongFibers(std::make_unique<FieldGlobalTerm>(), f.groom, 0.01f);

@@ -26,10 +26,12 @@ GlobalTerm lerp(float f, const GlobalTerm& a, const GlobalTerm& b) {
 
 class AlongFibers final : public LightGlobalTerm {
 public:
-    AlongFibers(std::unique_ptr<LightGlobalTerm> inner, const Groom& groom, float spacing)
+    AlongFibers(std::unique_ptr<LightGlobalTerm> inner, const Groom& groom, float spacing,
+                bool shareVertices)
         : inner_(std::move(inner))
         , groom_(groom)
-        , spacing_(spacing) {}
+        , spacing_(spacing)
+        , shareVertices_(shareVertices) {}
 
     std::size_t memoryBytes() const override { return inner_->memoryBytes(); }
     bool blocksEverything() const override { return inner_->blocksEverything(); }
@@ -42,7 +44,7 @@ public:
         };
         ThreadScratch<Scratch> scratch;
         auto& [plan, values] = *scratch;
-        plan.plan(queries, groom_, spacing_);
+        plan.plan(queries, groom_, spacing_, shareVertices_);
         values.resize(plan.samples().size()); // every element written by the inner term
         GlobalTermStats stats = inner_->evaluate(plan.samples(), values);
         plan.interpolate(values, out);
@@ -54,18 +56,22 @@ private:
     std::unique_ptr<LightGlobalTerm> inner_;
     const Groom& groom_;
     float spacing_;
+    bool shareVertices_;
 };
 
 } // namespace
 
 void FiberSamplePlan::plan(std::span<const GlobalTermQuery> queries, const Groom& groom,
-                           float spacing) {
+                           float spacing, bool shareVertices) {
     const std::vector<Vec3f>& points = groom.points;
     // Per query: the sample at or below it and the fraction toward the next
     // one, which is the sample after it; a query on a sample (f = 0: a strand
     // vertex, as the vertex rate and the tail shade) needs that sample alone.
     samples_.clear();
     where_.resize(queries.size());
+    // The last sample planned, when it is the tip-side vertex of the segment
+    // of the run before: (that segment's root-side point, its strand).
+    std::uint32_t vertexAfter = kUnknownSegment, vertexStrand = kUnknownStrand;
     std::size_t i = 0;
     while (i < queries.size()) {
         const GlobalTermQuery& q = queries[i];
@@ -73,6 +79,7 @@ void FiberSamplePlan::plan(std::span<const GlobalTermQuery> queries, const Groom
             std::size_t(q.segment) + 1 >= points.size()) {
             where_[i++] = {static_cast<std::uint32_t>(samples_.size()), 0.0f};
             samples_.push_back(q);
+            vertexAfter = kUnknownSegment;
             continue;
         }
         // The run of queries on this segment, each at t = x/m, x ∈ [k, k + 1].
@@ -114,16 +121,24 @@ void FiberSamplePlan::plan(std::span<const GlobalTermQuery> queries, const Groom
             std::sort(needed_.begin(), needed_.end());
             needed_.erase(std::unique(needed_.begin(), needed_.end()), needed_.end());
         }
-        const auto base = static_cast<std::uint32_t>(samples_.size());
+        // The run before ended on this segment's root-side vertex: that
+        // sample is this run's first (k = 0), the same position and strand.
+        const bool shared = shareVertices && vertexAfter != kUnknownSegment &&
+                            vertexAfter + 1 == q.segment && vertexStrand == q.strand &&
+                            needed_.front() == 0;
+        const auto base = static_cast<std::uint32_t>(samples_.size() - (shared ? 1 : 0));
         const Vec3f tangent = normalizeOr(d, q.tangent);
-        for (int k : needed_) {
+        for (std::size_t n = shared ? 1 : 0; n < needed_.size(); ++n) {
+            const int k = needed_[n];
             // Field by field into the array: a whole query built on the stack
             // and copied was read back in 16-byte pieces over its 1-byte
             // fields just stored, a store-forwarding stall (its two
             // instructions took a fifth of this function's samples on the
             // head; the function's samples fell 7%).
             GlobalTermQuery& sample = samples_.emplace_back();
-            sample.position = p0 + (float(k) / float(m)) * d;
+            // The ends are the strand's vertices exactly (p0 + 1·d may round
+            // away from p1), so that the two segments meeting there agree.
+            sample.position = k == m ? points[q.segment + 1] : p0 + (float(k) / float(m)) * d;
             sample.tangent = tangent;
             sample.strand = q.strand;
             sample.onFiber = true;
@@ -137,6 +152,8 @@ void FiberSamplePlan::plan(std::span<const GlobalTermQuery> queries, const Groom
                       : std::lower_bound(needed_.begin(), needed_.end(), k) - needed_.begin();
             where_[j].sample = base + static_cast<std::uint32_t>(offset);
         }
+        vertexAfter = needed_.back() == m ? q.segment : kUnknownSegment;
+        vertexStrand = q.strand;
         i = end;
     }
 }
@@ -150,10 +167,11 @@ void FiberSamplePlan::interpolate(std::span<const GlobalTerm> values,
 }
 
 std::unique_ptr<LightGlobalTerm> alongFibers(std::unique_ptr<LightGlobalTerm> inner,
-                                             const Groom& groom, float spacing) {
+                                             const Groom& groom, float spacing,
+                                             bool shareVertices) {
     if (!(spacing > 0))
         return inner;
-    return std::make_unique<AlongFibers>(std::move(inner), groom, spacing);
+    return std::make_unique<AlongFibers>(std::move(inner), groom, spacing, shareVertices);
 }
 
 } // namespace hairvox

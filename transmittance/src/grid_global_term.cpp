@@ -404,8 +404,11 @@ std::unique_ptr<LightGlobalTerm> GridModel::forLight(const Light& light,
     std::unique_ptr<LightGlobalTerm> term =
         std::make_unique<GridLightGlobalTerm>(*this, light, rates);
     if (settings_.groom)
+        // Grid mode reads no sample's tangent: a strand vertex is one
+        // sample for both its segments (approx mode's differ by tangent).
         term = alongFibers(std::move(term), *settings_.groom,
-                           options_.fiberSampleSpacing * static_cast<float>(voxelSize()));
+                           options_.fiberSampleSpacing * static_cast<float>(voxelSize()),
+                           mode() == GlobalTermMode::Grid);
     // Surfaces outermost: their shadow is exact per point, not interpolated.
     return withSurfaces(std::move(term), settings_.surfaces, light);
 }

@@ -59,7 +59,7 @@ struct GlobalTermQuery {
 struct GlobalTermStats {
     std::uint64_t queries = 0;
     std::uint64_t blockedBySurface = 0; ///< shadowed by an opaque surface: no march, no rays
-    std::uint64_t emptyPaths = 0;        ///< of the points evaluated, nothing in front: n = 0
+    std::uint64_t emptyPaths = 0;       ///< of the points evaluated, nothing in front: n = 0
     /// Points the mode evaluated: the queries not blocked by a surface, or
     /// fewer — the samples along the fibers they were interpolated from (alongFibers()).
     std::uint64_t evaluated = 0;
@@ -157,7 +157,12 @@ GlobalTerm globalTermFromDepths(float n, const Rgb& tauP, const Rgb& sumBeta2, f
 class FiberSamplePlan {
 public:
     /// Plans `queries` as alongFibers() does (`spacing` in world units, > 0).
-    void plan(std::span<const GlobalTermQuery> queries, const Groom& groom, float spacing);
+    /// With `shareVertices`, a strand vertex ending one run and starting the
+    /// next (segments s and s + 1 of a strand, one after the other) is one
+    /// sample: for evaluations that do not read a sample's tangent (grid
+    /// mode), whose value at a vertex is then the same from either segment.
+    void plan(std::span<const GlobalTermQuery> queries, const Groom& groom, float spacing,
+              bool shareVertices = false);
     /// The points to evaluate.
     std::span<const GlobalTermQuery> samples() const { return samples_; }
     /// out[j], the global term at query j, from the samples' values
@@ -179,15 +184,20 @@ private:
 /// Wraps a per-light evaluation so that a point on a fiber segment
 /// (GlobalTermQuery::segment) gets the global term interpolated linearly
 /// between samples along that segment, at t = k/m with m = ⌈length/spacing⌉
-/// (world units): the global term varies on the scale of the grid's voxels,
-/// a fragment every pixel. A batch evaluates each sample its queries need
+/// (world units; the samples at t = 0 and 1 are the strand's vertices
+/// exactly): the global term varies on the scale of the grid's voxels, a
+/// fragment every pixel. A batch evaluates each sample its queries need
 /// once per run of consecutive queries on one segment (callers that order
-/// their points by segment share the most). A sample's position depends only
-/// on its segment, so batches, tiles and thread counts agree; queries without
-/// a segment, or not on a fiber, are evaluated as they are. The samples take
-/// the segment's direction as their tangent (what approx mode reads).
+/// their points by segment share the most), and with `shareVertices` once
+/// for the two runs of consecutive segments of a strand that meet at it
+/// (FiberSamplePlan::plan). A sample's position depends only on its segment,
+/// so batches, tiles and thread counts agree; queries without a segment, or
+/// not on a fiber, are evaluated as they are. The samples take the segment's
+/// direction as their tangent (what approx mode reads: it must not share
+/// vertices).
 std::unique_ptr<LightGlobalTerm> alongFibers(std::unique_ptr<LightGlobalTerm> inner,
-                                             const Groom& groom, float spacing);
+                                             const Groom& groom, float spacing,
+                                             bool shareVertices = false);
 
 /// Wraps a per-light evaluation so that points whose path to the light meets
 /// an opaque surface get GlobalTerm::blocked() without being evaluated: one
