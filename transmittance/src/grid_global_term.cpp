@@ -19,6 +19,7 @@
 #include <cmath>
 #include <iostream>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <vector>
 
@@ -77,6 +78,37 @@ constexpr const char* kLightCacheKind = "light";
 /// Beyond this optical depth in n and every channel of tauP, V and P are
 /// below 1e-7: the rest of the path cannot change the global term.
 constexpr float kOpaqueDepth = 16.2f;
+
+/// The optical depth, in expected crossings, that a point's own fiber adds to
+/// the grid's integral from `start` along a shadow ray that leaves it at
+/// inclination θ (cos θ = |ω × u|): a fiber splatted k·D_i = `ribbonWidth`
+/// wide into voxels of size h, integrated through a cache whose lines lie
+/// `lineSpacing` voxels apart (0: marched). docs/DESIGN.md §5.
+///
+/// Splatting is the adjoint of trilinear reconstruction, so averaged over the
+/// point's place in its voxel the own fiber's reconstructed density is its
+/// centreline convolved with K = ∏_axes B₃(x_i/h)/h³ (B₃ = tent ∗ tent,
+/// variance h²/3 per axis); the cache's bilinear interpolation between its
+/// lines adds a tent of half-width `lineSpacing`·h across the ray (variance
+/// lineSpacing²·h²/6). Along the ray the own fiber's rate is λ_own·k·D·cos θ;
+/// substituting p = sω − lu (Jacobian cos θ) turns ∫ds ∫dl into an integral
+/// of K over the plane of ω and u, and the cos θ cancels:
+///   n_own = k·D·∫_{s > start} K dA.
+/// With K taken as Gaussian of variance σ² (the B₃ product's marginal peak on
+/// a plane is 0.669–0.689/h over orientations, the Gaussian's 0.691/h), the
+/// plane integral is the normal marginal's peak 1/(√(2π)·σ) times the share of
+/// the in-plane kernel beyond the line s = start, a distance start·cos θ away:
+///   n_own = k·D/(√(2π)·σ) · ½·erfc(start·cos θ / (√2·σ)),
+///   σ² = h²·(1/3 + lineSpacing²/6).
+/// At start 0 that is 0.34·k·D/h crossings marched, 0.24·k·D/h through the
+/// default cache.
+float ownFiberCrossings(float ribbonWidth, float cosTheta, float start, float h,
+                        float lineSpacing) {
+    const float sigma = h * std::sqrt(1.0f / 3.0f + lineSpacing * lineSpacing / 6.0f);
+    return ribbonWidth * std::numbers::inv_sqrtpi_v<float> /
+           (std::numbers::sqrt2_v<float> * sigma) * 0.5f *
+           std::erfc(start * cosTheta / (std::numbers::sqrt2_v<float> * sigma));
+}
 
 /// What the per-voxel rates are made of: the fiber grid's statistics at one voxel.
 struct VoxelFibers {
@@ -245,8 +277,7 @@ void GridModel::fillRates(BrickVolume& volume, const Light& light) const {
                 } else {
                     for (std::size_t t = 0; t < grid_.typeFraction.size(); ++t)
                         if (const float f = grid_.typeFraction[t][i]; f > 0)
-                            r += expectedRates(fibers, omega, crossings_[t],
-                                               options_.orientation) *
+                            r += expectedRates(fibers, omega, crossings_[t], options_.orientation) *
                                  f;
                 }
                 const float scale = fibers.lambda * kD;
@@ -316,8 +347,9 @@ public:
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, queries.size(), kBatch),
                           [&](const tbb::blocked_range<std::size_t>& range) {
                               for (std::size_t b = range.begin(); b < range.end(); b += kBatch)
-                                  evaluateBatch(queries.subspan(b, std::min(kBatch, range.end() - b)),
-                                                out.subspan(b), std::span(empty).subspan(b));
+                                  evaluateBatch(
+                                      queries.subspan(b, std::min(kBatch, range.end() - b)),
+                                      out.subspan(b), std::span(empty).subspan(b));
                           });
         GlobalTermStats stats;
         stats.queries = stats.evaluated = queries.size();
@@ -363,9 +395,32 @@ private:
             else
                 depths[k] = rates_->integrate(queries[q].position, paths[q].omega, start,
                                               paths[q].distance, kOpaqueDepth, touched);
+            if (queries[q].onFiber)
+                leaveOutOwnFiber(queries[q], paths[q], start, depths[k]);
             out[q] = fromDepths(queries[q], paths[q], depths[k]);
             empty[q] = touched ? 0 : 1;
         }
+    }
+
+    /// Takes the expected optical depth of query q's own fiber beyond `start`
+    /// (ownFiberCrossings()) out of d: the grid splats every fiber, exact mode
+    /// and the path tracer skip the point's own (RayScene::isOwnFiber) — the
+    /// whole ribbon of k hairs, as the grid's own splat is. Each channel loses
+    /// that many crossings at the own fiber's inclination, and stays ≥ 0.
+    void leaveOutOwnFiber(const GlobalTermQuery& q, const Light::Path& path, float start,
+                          OpticalDepths& d) const {
+        const GlobalTermSettings& settings = model_.settings();
+        const float kD = settings.groom && q.segment != kUnknownSegment
+                             ? ribbonWidthAt(*settings.groom, settings.fiberScale, q.segment)
+                             : settings.fiberScale.ribbonWidth();
+        const float sinTheta = std::clamp(glm::dot(path.omega, q.tangent), -1.0f, 1.0f);
+        const float c = ownFiberCrossings(kD, std::sqrt(1.0f - sinTheta * sinTheta), start,
+                                          static_cast<float>(model_.voxelSize()),
+                                          cache_ ? model_.options().cacheSpacing : 0.0f);
+        const CrossingTable::Values x = model_.crossings(q.fiberType).crossing(sinTheta);
+        d.n = std::max(d.n - c, 0.0f);
+        d.tauP = max(d.tauP - c * tauPPerCrossing(x), Rgb(0.0f));
+        d.sumBeta2 = max(d.sumBeta2 - c * x.beta2Bar_f, Rgb(0.0f));
     }
 
     /// The global term of query q from the optical depths along its path.
@@ -377,10 +432,15 @@ private:
         // approx: every fiber in front shares the shading point's orientation and type.
         const float s = glm::dot(path.omega, q.tangent);
         const CrossingTable::Values x = model_.crossings(q.fiberType).crossing(s);
-        const Rgb perCrossing = model_.options().estimator == AttenuationEstimator::Poisson
-                                    ? Rgb(1.0f) - exp(x.logABar_f)
-                                    : -x.logABar_f;
-        return globalTermFromDepths(d.n, d.n * perCrossing, d.n * x.beta2Bar_f, d_f);
+        return globalTermFromDepths(d.n, d.n * tauPPerCrossing(x), d.n * x.beta2Bar_f, d_f);
+    }
+
+    /// What one crossing of values x adds to tauP under the model's estimator:
+    /// 1 − ā_f (Poisson) or −ln ā_f (geometric).
+    Rgb tauPPerCrossing(const CrossingTable::Values& x) const {
+        return model_.options().estimator == AttenuationEstimator::Poisson
+                   ? Rgb(1.0f) - exp(x.logABar_f)
+                   : -x.logABar_f;
     }
 
     const GridModel& model_;
@@ -428,8 +488,8 @@ std::unique_ptr<GlobalTermModel> makeApproxModel(const FiberGrid& grid, Crossing
     settings.validate();
     options.validate(grid);
     checkCrossingTables(crossings, grid.fiberTypeCount());
-    return std::make_unique<GridModel>(GlobalTermMode::Approx, grid, std::move(crossings),
-                                       settings, options);
+    return std::make_unique<GridModel>(GlobalTermMode::Approx, grid, std::move(crossings), settings,
+                                       options);
 }
 
 } // namespace hairvox
