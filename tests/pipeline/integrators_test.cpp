@@ -178,11 +178,13 @@ double gridOverExactDirect(Scene scene, const test::TempDir& dir,
                      ->relBias;
 }
 
-TEST(IntegratorsSlow, GridStartOffsetCentresTheVisibleDirectTermOnExact) {
+TEST(IntegratorsSlow, GridStartOffsetOnASparseGroom) {
     // With the own fiber's optical depth taken out, what the start offset
     // skips is the splat of the fibers under a visible point smeared out in
-    // front of it (docs/DESIGN.md §8): from the point the image is dark,
-    // a voxel ahead bright, 0.4 — the default — between.
+    // front of it — a dense layer's (docs/DESIGN.md §8). This groom (1,500
+    // strands, k = 3) has none: from the point grid is exact's (measured
+    // +0.03%), and each offset brightens it by what it skips (0.4, the
+    // default: +1.3%; 1: +3.1%).
     test::TempDir dir;
     Scene scene = smallDefault();
     scene.camera.width = scene.camera.height = 128;
@@ -190,11 +192,11 @@ TEST(IntegratorsSlow, GridStartOffsetCentresTheVisibleDirectTermOnExact) {
     for (const float offset : {0.0f, 0.4f, 1.0f}) {
         error[offset] = gridOverExactDirect(scene, dir, GridEvaluation::Cache, offset) - 1.0;
         RecordProperty("error at offset " + std::to_string(offset), std::to_string(error[offset]));
-        std::cout << "start offset " << offset << ": grid / exact − 1 = " << error[offset] << "\n";
     }
     EXPECT_EQ(GridOptions{}.startOffset, 0.4f);
-    EXPECT_LT(error[0.0f], 0.0);
-    EXPECT_GT(error[1.0f], 0.0);
+    EXPECT_LT(std::abs(error[0.0f]), 0.01);
+    EXPECT_LT(error[0.0f], error[0.4f]);
+    EXPECT_LT(error[0.4f], error[1.0f]);
     EXPECT_LT(std::abs(error[0.4f]), 0.02);
 }
 
