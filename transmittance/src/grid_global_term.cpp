@@ -7,6 +7,7 @@
 #include <hairvox/core/error.h>
 #include <hairvox/core/hash.h>
 #include <hairvox/core/interrupt.h>
+#include <hairvox/core/math.h>
 #include <hairvox/core/thread_scratch.h>
 #include <hairvox/transmittance/grid_global_term.h>
 #include <hairvox/voxelize/fiber_grid.h>
@@ -176,6 +177,7 @@ public:
 
     /// The crossing table of fiber type `type`.
     const CrossingTable& crossings(std::uint8_t type) const { return crossings_.at(type); }
+    std::size_t crossingTypes() const { return crossings_.size(); }
     /// The disk cache's key of a light's prepared cache: the caller's key of
     /// the grid, tables and settings (GlobalTermSettings::diskCacheKey), what
     /// of the options the cache is made of, and the light.
@@ -304,8 +306,10 @@ public:
         if (disk) {
             if (const auto bytes = disk->load(kLightCacheKind, key)) {
                 cache_ = LightSpaceCache::deserialize(*bytes);
-                if (cache_)
+                if (cache_) {
+                    tabulateOwnFiber();
                     return;
+                }
                 std::cerr << "hairvox: warning: cache entry "
                           << disk->entryPath(kLightCacheKind, key).string()
                           << " is not a light-space cache of this build; computed again\n";
@@ -330,6 +334,7 @@ public:
         const auto& stores = model.settings().diskCacheStores;
         if (disk && cache_ && (!stores || stores(light)))
             disk->store(kLightCacheKind, key, cache_->serialize());
+        tabulateOwnFiber();
     }
 
     std::size_t memoryBytes() const override {
@@ -396,31 +401,58 @@ private:
                 depths[k] = rates_->integrate(queries[q].position, paths[q].omega, start,
                                               paths[q].distance, kOpaqueDepth, touched);
             if (queries[q].onFiber)
-                leaveOutOwnFiber(queries[q], paths[q], start, depths[k]);
+                leaveOutOwnFiber(queries[q], paths[q], depths[k]);
             out[q] = fromDepths(queries[q], paths[q], depths[k]);
             empty[q] = touched ? 0 : 1;
         }
     }
 
-    /// Takes the expected optical depth of query q's own fiber beyond `start`
-    /// (ownFiberCrossings()) out of d: the grid splats every fiber, exact mode
-    /// and the path tracer skip the point's own (RayScene::isOwnFiber) — the
-    /// whole ribbon of k hairs, as the grid's own splat is. Each channel loses
-    /// that many crossings at the own fiber's inclination, and stays ≥ 0.
-    void leaveOutOwnFiber(const GlobalTermQuery& q, const Light::Path& path, float start,
+    /// Entries of the own fiber's table over θ ∈ [−π/2, π/2].
+    static constexpr std::size_t kOwnFiberEntries = 257;
+
+    /// ownFiber_[type][j]: the optical depths a fiber of unit k·D_i adds beyond
+    /// the start offset (ownFiberCrossings()) at θ_j — n_own crossings, each
+    /// adding 1 to n, its tauP (tauPPerCrossing()) and β̄_f² at θ_j. Per light:
+    /// the blur depends on whether its queries go through a cache.
+    void tabulateOwnFiber() {
+        const float h = static_cast<float>(model_.voxelSize());
+        const float start = model_.options().startOffset * h;
+        const float lineSpacing = cache_ ? model_.options().cacheSpacing : 0.0f;
+        ownFiber_.resize(model_.crossingTypes());
+        for (std::size_t type = 0; type < ownFiber_.size(); ++type) {
+            ownFiber_[type].resize(kOwnFiberEntries);
+            for (std::size_t j = 0; j < kOwnFiberEntries; ++j) {
+                const float theta = static_cast<float>(-PiOver2 + Pi * static_cast<double>(j) /
+                                                                      double(kOwnFiberEntries - 1));
+                const float c = ownFiberCrossings(1.0f, std::cos(theta), start, h, lineSpacing);
+                const CrossingTable::Values x =
+                    model_.crossings(static_cast<std::uint8_t>(type)).crossing(std::sin(theta));
+                ownFiber_[type][j] = {c, c * tauPPerCrossing(x), c * x.beta2Bar_f};
+            }
+        }
+    }
+
+    /// Takes the expected optical depths of query q's own fiber beyond the
+    /// start offset (ownFiber_) out of d: the grid splats every fiber, exact
+    /// mode and the path tracer skip the point's own (RayScene::isOwnFiber) —
+    /// the whole ribbon of k hairs, as the grid's own splat is. Each channel
+    /// stays ≥ 0.
+    void leaveOutOwnFiber(const GlobalTermQuery& q, const Light::Path& path,
                           OpticalDepths& d) const {
         const GlobalTermSettings& settings = model_.settings();
         const float kD = settings.groom && q.segment != kUnknownSegment
                              ? ribbonWidthAt(*settings.groom, settings.fiberScale, q.segment)
                              : settings.fiberScale.ribbonWidth();
         const float sinTheta = std::clamp(glm::dot(path.omega, q.tangent), -1.0f, 1.0f);
-        const float c = ownFiberCrossings(kD, std::sqrt(1.0f - sinTheta * sinTheta), start,
-                                          static_cast<float>(model_.voxelSize()),
-                                          cache_ ? model_.options().cacheSpacing : 0.0f);
-        const CrossingTable::Values x = model_.crossings(q.fiberType).crossing(sinTheta);
-        d.n = std::max(d.n - c, 0.0f);
-        d.tauP = max(d.tauP - c * tauPPerCrossing(x), Rgb(0.0f));
-        d.sumBeta2 = max(d.sumBeta2 - c * x.beta2Bar_f, Rgb(0.0f));
+        const float x = (safeASin(sinTheta) + static_cast<float>(PiOver2)) *
+                        static_cast<float>(double(kOwnFiberEntries - 1) / Pi);
+        const auto j = std::min(static_cast<std::size_t>(std::max(x, 0.0f)), kOwnFiberEntries - 2);
+        const float t = std::clamp(x - static_cast<float>(j), 0.0f, 1.0f);
+        const std::vector<OpticalDepths>& table = ownFiber_[q.fiberType];
+        const OpticalDepths own = (table[j] * (1.0f - t) + table[j + 1] * t) * kD;
+        d.n = std::max(d.n - own.n, 0.0f);
+        d.tauP = max(d.tauP - own.tauP, Rgb(0.0f));
+        d.sumBeta2 = max(d.sumBeta2 - own.sumBeta2, Rgb(0.0f));
     }
 
     /// The global term of query q from the optical depths along its path.
@@ -449,6 +481,7 @@ private:
     std::optional<BrickVolume> rates_;
     /// Empty when evaluating by march, or for a point light inside the volume.
     std::optional<LightSpaceCache> cache_;
+    std::vector<std::vector<OpticalDepths>> ownFiber_; ///< per fiber type, see tabulateOwnFiber()
 };
 
 std::unique_ptr<LightWorkspace> GridModel::makeWorkspace() const {
