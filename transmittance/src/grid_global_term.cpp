@@ -407,13 +407,14 @@ private:
         }
     }
 
-    /// Entries of the own fiber's table over θ ∈ [−π/2, π/2].
+    /// Entries of the own fiber's table, uniform in sin θ ∈ [−1, 1] (no asin
+    /// per query; the sin θ-steep ends, within 7° of the poles, weigh little).
     static constexpr std::size_t kOwnFiberEntries = 257;
 
     /// ownFiber_[type][j]: the optical depths a fiber of unit k·D_i adds beyond
-    /// the start offset (ownFiberCrossings()) at θ_j — n_own crossings, each
-    /// adding 1 to n, its tauP (tauPPerCrossing()) and β̄_f² at θ_j. Per light:
-    /// the blur depends on whether its queries go through a cache.
+    /// the start offset (ownFiberCrossings()) at sin θ_j — n_own crossings,
+    /// each adding 1 to n, its tauP (tauPPerCrossing()) and β̄_f² at θ_j. Per
+    /// light: the blur depends on whether its queries go through a cache.
     void tabulateOwnFiber() {
         const float h = static_cast<float>(model_.voxelSize());
         const float start = model_.options().startOffset * h;
@@ -422,11 +423,12 @@ private:
         for (std::size_t type = 0; type < ownFiber_.size(); ++type) {
             ownFiber_[type].resize(kOwnFiberEntries);
             for (std::size_t j = 0; j < kOwnFiberEntries; ++j) {
-                const float theta = static_cast<float>(-PiOver2 + Pi * static_cast<double>(j) /
-                                                                      double(kOwnFiberEntries - 1));
-                const float c = ownFiberCrossings(1.0f, std::cos(theta), start, h, lineSpacing);
+                const float sinTheta =
+                    -1.0f + 2.0f * static_cast<float>(j) / float(kOwnFiberEntries - 1);
+                const float c = ownFiberCrossings(1.0f, safeSqrt(1.0f - sinTheta * sinTheta), start,
+                                                  h, lineSpacing);
                 const CrossingTable::Values x =
-                    model_.crossings(static_cast<std::uint8_t>(type)).crossing(std::sin(theta));
+                    model_.crossings(static_cast<std::uint8_t>(type)).crossing(sinTheta);
                 ownFiber_[type][j] = {c, c * tauPPerCrossing(x), c * x.beta2Bar_f};
             }
         }
@@ -444,8 +446,7 @@ private:
                              ? ribbonWidthAt(*settings.groom, settings.fiberScale, q.segment)
                              : settings.fiberScale.ribbonWidth();
         const float sinTheta = std::clamp(glm::dot(path.omega, q.tangent), -1.0f, 1.0f);
-        const float x = (safeASin(sinTheta) + static_cast<float>(PiOver2)) *
-                        static_cast<float>(double(kOwnFiberEntries - 1) / Pi);
+        const float x = (sinTheta + 1.0f) * (0.5f * float(kOwnFiberEntries - 1));
         const auto j = std::min(static_cast<std::size_t>(std::max(x, 0.0f)), kOwnFiberEntries - 2);
         const float t = std::clamp(x - static_cast<float>(j), 0.0f, 1.0f);
         const std::vector<OpticalDepths>& table = ownFiber_[q.fiberType];
