@@ -178,10 +178,10 @@ TEST(GlobalTermAccuracySlow, StartOffsetMeasuredAgainstExact) {
         std::snprintf(label, sizeof(label), "start offset %.1f voxels", double(offset));
         probe.print(label, results[offset]);
     }
-    // Over random points inside the groom, 0 has the smallest bias: the
-    // splat's own-fiber density at the start is small (≈ kD/2h) next to what
-    // an offset leaves out. (The visible outer layer prefers 0.5, the default:
-    // pipeline/integrators_test.)
+    // Over random points inside the groom, 0 has the smallest bias: the own
+    // fiber's optical depth is taken out (grid_global_term.h), and an offset
+    // leaves out the fibers in front too. (The visible top of a dense layer
+    // prefers 0.4, the default: pipeline/integrators_test.)
     const double bias0 = std::abs(results[0.0f].error.biasN);
     for (const float offset : {0.5f, 1.0f, 2.0f})
         EXPECT_LT(bias0, std::abs(results[offset].error.biasN)) << offset;

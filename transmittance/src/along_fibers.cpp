@@ -143,7 +143,7 @@ void FiberSamplePlan::plan(std::span<const GlobalTermQuery> queries, const Groom
             sample.strand = q.strand;
             sample.onFiber = true;
             sample.fiberType = q.fiberType;
-            sample.segment = kUnknownSegment;
+            sample.segment = q.segment;
         }
         for (std::size_t j = i; j < end; ++j) {
             const int k = static_cast<int>(where_[j].sample);

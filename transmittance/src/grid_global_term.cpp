@@ -7,6 +7,7 @@
 #include <hairvox/core/error.h>
 #include <hairvox/core/hash.h>
 #include <hairvox/core/interrupt.h>
+#include <hairvox/core/math.h>
 #include <hairvox/core/thread_scratch.h>
 #include <hairvox/transmittance/grid_global_term.h>
 #include <hairvox/voxelize/fiber_grid.h>
@@ -19,6 +20,7 @@
 #include <cmath>
 #include <iostream>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <vector>
 
@@ -77,6 +79,37 @@ constexpr const char* kLightCacheKind = "light";
 /// Beyond this optical depth in n and every channel of tauP, V and P are
 /// below 1e-7: the rest of the path cannot change the global term.
 constexpr float kOpaqueDepth = 16.2f;
+
+/// The optical depth, in expected crossings, that a point's own fiber adds to
+/// the grid's integral from `start` along a shadow ray that leaves it at
+/// inclination θ (cos θ = |ω × u|): a fiber splatted k·D_i = `ribbonWidth`
+/// wide into voxels of size h, integrated through a cache whose lines lie
+/// `lineSpacing` voxels apart (0: marched). docs/DESIGN.md §5.
+///
+/// Splatting is the adjoint of trilinear reconstruction, so averaged over the
+/// point's place in its voxel the own fiber's reconstructed density is its
+/// centreline convolved with K = ∏_axes B₃(x_i/h)/h³ (B₃ = tent ∗ tent,
+/// variance h²/3 per axis); the cache's bilinear interpolation between its
+/// lines adds a tent of half-width `lineSpacing`·h across the ray (variance
+/// lineSpacing²·h²/6). Along the ray the own fiber's rate is λ_own·k·D·cos θ;
+/// substituting p = sω − lu (Jacobian cos θ) turns ∫ds ∫dl into an integral
+/// of K over the plane of ω and u, and the cos θ cancels:
+///   n_own = k·D·∫_{s > start} K dA.
+/// With K taken as Gaussian of variance σ² (the B₃ product's marginal peak on
+/// a plane is 0.669–0.689/h over orientations, the Gaussian's 0.691/h), the
+/// plane integral is the normal marginal's peak 1/(√(2π)·σ) times the share of
+/// the in-plane kernel beyond the line s = start, a distance start·cos θ away:
+///   n_own = k·D/(√(2π)·σ) · ½·erfc(start·cos θ / (√2·σ)),
+///   σ² = h²·(1/3 + lineSpacing²/6).
+/// At start 0 that is 0.34·k·D/h crossings marched, 0.24·k·D/h through the
+/// default cache.
+float ownFiberCrossings(float ribbonWidth, float cosTheta, float start, float h,
+                        float lineSpacing) {
+    const float sigma = h * std::sqrt(1.0f / 3.0f + lineSpacing * lineSpacing / 6.0f);
+    return ribbonWidth * std::numbers::inv_sqrtpi_v<float> /
+           (std::numbers::sqrt2_v<float> * sigma) * 0.5f *
+           std::erfc(start * cosTheta / (std::numbers::sqrt2_v<float> * sigma));
+}
 
 /// What the per-voxel rates are made of: the fiber grid's statistics at one voxel.
 struct VoxelFibers {
@@ -144,6 +177,7 @@ public:
 
     /// The crossing table of fiber type `type`.
     const CrossingTable& crossings(std::uint8_t type) const { return crossings_.at(type); }
+    std::size_t crossingTypes() const { return crossings_.size(); }
     /// The disk cache's key of a light's prepared cache: the caller's key of
     /// the grid, tables and settings (GlobalTermSettings::diskCacheKey), what
     /// of the options the cache is made of, and the light.
@@ -245,8 +279,7 @@ void GridModel::fillRates(BrickVolume& volume, const Light& light) const {
                 } else {
                     for (std::size_t t = 0; t < grid_.typeFraction.size(); ++t)
                         if (const float f = grid_.typeFraction[t][i]; f > 0)
-                            r += expectedRates(fibers, omega, crossings_[t],
-                                               options_.orientation) *
+                            r += expectedRates(fibers, omega, crossings_[t], options_.orientation) *
                                  f;
                 }
                 const float scale = fibers.lambda * kD;
@@ -273,8 +306,10 @@ public:
         if (disk) {
             if (const auto bytes = disk->load(kLightCacheKind, key)) {
                 cache_ = LightSpaceCache::deserialize(*bytes);
-                if (cache_)
+                if (cache_) {
+                    tabulateOwnFiber();
                     return;
+                }
                 std::cerr << "hairvox: warning: cache entry "
                           << disk->entryPath(kLightCacheKind, key).string()
                           << " is not a light-space cache of this build; computed again\n";
@@ -299,6 +334,7 @@ public:
         const auto& stores = model.settings().diskCacheStores;
         if (disk && cache_ && (!stores || stores(light)))
             disk->store(kLightCacheKind, key, cache_->serialize());
+        tabulateOwnFiber();
     }
 
     std::size_t memoryBytes() const override {
@@ -316,8 +352,9 @@ public:
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, queries.size(), kBatch),
                           [&](const tbb::blocked_range<std::size_t>& range) {
                               for (std::size_t b = range.begin(); b < range.end(); b += kBatch)
-                                  evaluateBatch(queries.subspan(b, std::min(kBatch, range.end() - b)),
-                                                out.subspan(b), std::span(empty).subspan(b));
+                                  evaluateBatch(
+                                      queries.subspan(b, std::min(kBatch, range.end() - b)),
+                                      out.subspan(b), std::span(empty).subspan(b));
                           });
         GlobalTermStats stats;
         stats.queries = stats.evaluated = queries.size();
@@ -363,9 +400,60 @@ private:
             else
                 depths[k] = rates_->integrate(queries[q].position, paths[q].omega, start,
                                               paths[q].distance, kOpaqueDepth, touched);
+            if (queries[q].onFiber)
+                leaveOutOwnFiber(queries[q], paths[q], depths[k]);
             out[q] = fromDepths(queries[q], paths[q], depths[k]);
             empty[q] = touched ? 0 : 1;
         }
+    }
+
+    /// Entries of the own fiber's table, uniform in sin θ ∈ [−1, 1] (no asin
+    /// per query; the sin θ-steep ends, within 7° of the poles, weigh little).
+    static constexpr std::size_t kOwnFiberEntries = 257;
+
+    /// ownFiber_[type][j]: the optical depths a fiber of unit k·D_i adds beyond
+    /// the start offset (ownFiberCrossings()) at sin θ_j — n_own crossings,
+    /// each adding 1 to n, its tauP (tauPPerCrossing()) and β̄_f² at θ_j. Per
+    /// light: the blur depends on whether its queries go through a cache.
+    void tabulateOwnFiber() {
+        const float h = static_cast<float>(model_.voxelSize());
+        const float start = model_.options().startOffset * h;
+        const float lineSpacing = cache_ ? model_.options().cacheSpacing : 0.0f;
+        ownFiber_.resize(model_.crossingTypes());
+        for (std::size_t type = 0; type < ownFiber_.size(); ++type) {
+            ownFiber_[type].resize(kOwnFiberEntries);
+            for (std::size_t j = 0; j < kOwnFiberEntries; ++j) {
+                const float sinTheta =
+                    -1.0f + 2.0f * static_cast<float>(j) / float(kOwnFiberEntries - 1);
+                const float c = ownFiberCrossings(1.0f, safeSqrt(1.0f - sinTheta * sinTheta), start,
+                                                  h, lineSpacing);
+                const CrossingTable::Values x =
+                    model_.crossings(static_cast<std::uint8_t>(type)).crossing(sinTheta);
+                ownFiber_[type][j] = {c, c * tauPPerCrossing(x), c * x.beta2Bar_f};
+            }
+        }
+    }
+
+    /// Takes the expected optical depths of query q's own fiber beyond the
+    /// start offset (ownFiber_) out of d: the grid splats every fiber, exact
+    /// mode and the path tracer skip the point's own (RayScene::isOwnFiber) —
+    /// the whole ribbon of k hairs, as the grid's own splat is. Each channel
+    /// stays ≥ 0.
+    void leaveOutOwnFiber(const GlobalTermQuery& q, const Light::Path& path,
+                          OpticalDepths& d) const {
+        const GlobalTermSettings& settings = model_.settings();
+        const float kD = settings.groom && q.segment != kUnknownSegment
+                             ? ribbonWidthAt(*settings.groom, settings.fiberScale, q.segment)
+                             : settings.fiberScale.ribbonWidth();
+        const float sinTheta = std::clamp(glm::dot(path.omega, q.tangent), -1.0f, 1.0f);
+        const float x = (sinTheta + 1.0f) * (0.5f * float(kOwnFiberEntries - 1));
+        const auto j = std::min(static_cast<std::size_t>(std::max(x, 0.0f)), kOwnFiberEntries - 2);
+        const float t = std::clamp(x - static_cast<float>(j), 0.0f, 1.0f);
+        const std::vector<OpticalDepths>& table = ownFiber_[q.fiberType];
+        const OpticalDepths own = (table[j] * (1.0f - t) + table[j + 1] * t) * kD;
+        d.n = std::max(d.n - own.n, 0.0f);
+        d.tauP = max(d.tauP - own.tauP, Rgb(0.0f));
+        d.sumBeta2 = max(d.sumBeta2 - own.sumBeta2, Rgb(0.0f));
     }
 
     /// The global term of query q from the optical depths along its path.
@@ -377,10 +465,15 @@ private:
         // approx: every fiber in front shares the shading point's orientation and type.
         const float s = glm::dot(path.omega, q.tangent);
         const CrossingTable::Values x = model_.crossings(q.fiberType).crossing(s);
-        const Rgb perCrossing = model_.options().estimator == AttenuationEstimator::Poisson
-                                    ? Rgb(1.0f) - exp(x.logABar_f)
-                                    : -x.logABar_f;
-        return globalTermFromDepths(d.n, d.n * perCrossing, d.n * x.beta2Bar_f, d_f);
+        return globalTermFromDepths(d.n, d.n * tauPPerCrossing(x), d.n * x.beta2Bar_f, d_f);
+    }
+
+    /// What one crossing of values x adds to tauP under the model's estimator:
+    /// 1 − ā_f (Poisson) or −ln ā_f (geometric).
+    Rgb tauPPerCrossing(const CrossingTable::Values& x) const {
+        return model_.options().estimator == AttenuationEstimator::Poisson
+                   ? Rgb(1.0f) - exp(x.logABar_f)
+                   : -x.logABar_f;
     }
 
     const GridModel& model_;
@@ -389,6 +482,7 @@ private:
     std::optional<BrickVolume> rates_;
     /// Empty when evaluating by march, or for a point light inside the volume.
     std::optional<LightSpaceCache> cache_;
+    std::vector<std::vector<OpticalDepths>> ownFiber_; ///< per fiber type, see tabulateOwnFiber()
 };
 
 std::unique_ptr<LightWorkspace> GridModel::makeWorkspace() const {
@@ -431,8 +525,8 @@ std::unique_ptr<GlobalTermModel> makeApproxModel(const FiberGrid& grid, Crossing
     settings.validate();
     options.validate(grid);
     checkCrossingTables(crossings, grid.fiberTypeCount());
-    return std::make_unique<GridModel>(GlobalTermMode::Approx, grid, std::move(crossings),
-                                       settings, options);
+    return std::make_unique<GridModel>(GlobalTermMode::Approx, grid, std::move(crossings), settings,
+                                       options);
 }
 
 } // namespace hairvox
