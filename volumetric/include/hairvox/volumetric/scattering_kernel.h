@@ -1,62 +1,59 @@
-// hairvox volumetric: a fiber's scattering function projected onto the
-// radiance basis (radiance_basis.h) — Moon, Walter & Marschner 2008's
-// "scattering matrix", in the fiber's own frame.
+// hairvox volumetric: a fiber's scattering applied, in the fiber's own frame,
+// to radiance held in world-frame spherical harmonics — Moon, Walter &
+// Marschner 2008's "scattering matrix" (docs/DESIGN.md §9).
 //
-// The radiance a fiber of tangent ū sends toward ω_o from incident radiance L
-// is (docs/DESIGN.md §3, the renderer's convention)
-//     L_o(ω_o) = ∫ f_s(ω_i, ω_o) cos θ_i L(ω_i) dω_i,   dω_i = ds_i dφ_i.
-// With L in the basis and f_s even in Δφ = φ_o − φ_i (Marschner's N_p, with
-// the cross-section's orientation averaged out), the φ integral diagonalises:
-//     L_o(θ_o, φ_o) = Σ_i [a_i0 Ĝ_i0(θ_o) + Σ_k (a_ik cos kφ_o + b_ik sin kφ_o) Ĝ_ik(θ_o)],
-//     Ĝ_ik(θ_o) = ∫_{bin i} ds_i ∫_{−π}^{π} f_s(θ_i, θ_o, Δφ) cos θ_i cos(kΔφ) dΔφ   (RGB).
-// The kernel tabulates Ĝ at N_θ outgoing inclinations, the bins' centres in
-// s_o = sin θ_o (an outgoing radiance is then a basis-shaped table that a
-// lookup interpolates linearly in s_o), by Gauss–Legendre quadrature over each
-// bin (8 points) and the midpoint rule over the period in Δφ (256 points;
-// spectrally accurate for a periodic integrand).
+// The radiance a fiber of tangent u sends toward ω_o from the incident
+// radiance L̄ of its cell is (docs/DESIGN.md §3, the renderer's convention)
+//     L_o(ω_o) = ∫ K(ω_i) L̄(ω_i) dω_i,   K(ω_i) = f_s(u; ω_i, ω_o) cos θ_i.
+// L̄ is held to SH order L (spherical_harmonics.h), so only the projection
+// P_L[K] of the kernel onto the same orders counts:
+//     L_o = ∫ P_L[K] L̄ dω,
+// and the product of two functions of order L is integrated exactly by a
+// product rule of (L + 1) Gauss–Legendre nodes in s = sin θ (about u) by
+// 2L + 1 equally spaced azimuths. In the frame (e₁, e₂, u) with e₁ along ω_o's
+// azimuth (φ_o = 0), P_L[K] depends on s_o = ω_o·u alone, so the kernel
+// tabulates, at R outgoing s_o (rows, read linearly between), the weights
+//     W_jq = w_q · P_L[K_j](ω_q)   (RGB; K_j at s_o of row j),
+// P_L[K_j] projected by a fine quadrature of f_s (Gauss–Legendre panels in s,
+// the midpoint rule over the period in φ; the cross-section's twist averaged
+// when the fiber is eccentric). A fragment then evaluates its cell's L̄ at
+// the nodes rotated into its own frame:
+//     L_o = Σ_q W_q(s_o) L̄(s_q u + c_q (cos φ_q e₁ + sin φ_q e₂)).
+// This is the rotation of L̄ into the fiber's frame followed by the
+// scattering matrix, done at the nodes instead of on the coefficients: exact
+// for the order held, whatever the angle between the fiber and its cell's
+// other fibers.
 #pragma once
 
 #include <hairvox/core/rgb.h>
-#include <hairvox/volumetric/radiance_basis.h>
+#include <hairvox/core/vecmath.h>
 
-#include <span>
 #include <vector>
 
 namespace hairvox {
 
 class MarschnerBcsdf;
 
-/// Which of Marschner's lobes a kernel holds.
-enum class KernelLobes {
-    All,
-    Forward,  ///< TT
-    Backward, ///< R and TRT
-};
-
 class ScatteringKernel {
 public:
-    ScatteringKernel(const MarschnerBcsdf& bcsdf, const RadianceBasis& basis,
-                     KernelLobes lobes = KernelLobes::All);
+    /// The kernel of `bcsdf` for radiance held to SH order `order` ([1, 8]).
+    ScatteringKernel(const MarschnerBcsdf& bcsdf, int order);
 
-    const RadianceBasis& basis() const { return basis_; }
-    /// Ĝ_ik at the centre of outgoing bin j.
-    const Rgb& at(int j, int i, int k) const {
-        return g_[(std::size_t(j) * std::size_t(basis_.thetaBins) + std::size_t(i)) *
-                      std::size_t(basis_.azimuthalOrder + 1) +
-                  std::size_t(k)];
-    }
-    /// The outgoing table of an incident radiance: both are planar
-    /// [channel][bin][coefficient] arrays of 3·basis().coefficients() floats;
-    /// out[c][j][m] = Σ_i Ĝ_{i,k(m)}(θ_o,j)[c] · in[c][i][m].
-    void apply(std::span<const float> incident, std::span<float> outgoing) const;
+    int order() const { return order_; }
+    /// Outgoing inclinations tabulated (rows, s_o from −1 to 1).
+    static constexpr int kRows = 48;
+
+    /// L_o toward unit ω_o of a fiber of unit tangent u from the incident
+    /// radiance whose SH coefficients are `coefficients` (planar [channel][lm],
+    /// 3·(L + 1)² floats).
+    Rgb apply(const float* coefficients, const Vec3f& u, const Vec3f& omega_o) const;
 
 private:
-    RadianceBasis basis_;
-    std::vector<Rgb> g_; ///< [j][i][k]
-    /// apply()'s form of g_: [channel][j][i][m], Ĝ_{i,k(m)}(θ_o,j) repeated
-    /// for a_k and b_k, so that a row of coefficients is one contiguous
-    /// multiply-add.
-    std::vector<float> expanded_;
+    int order_;
+    int nodesS_, nodesPhi_;
+    std::vector<float> s_, cosTheta_;    ///< per s-node: s_q, √(1 − s_q²)
+    std::vector<float> cosPhi_, sinPhi_; ///< per φ-node
+    std::vector<Rgb> w_;                 ///< [row][s-node][φ-node]: W_jq
 };
 
 } // namespace hairvox
