@@ -52,9 +52,9 @@ std::string errorOf(const nlohmann::json& integrator) {
 
 TEST(Volumetric, SceneKeysAreReadAndCheckedPerIntegrator) {
     nlohmann::json j = nlohmann::json::parse(defaultSceneJson());
-    j["integrator"] = {{"type", "volumetric"},    {"paths", 1000},        {"cell_voxels", 3},
-                       {"sh_order", 4},           {"max_depth", 40},
-                       {"roulette_depth", 5},     {"seed", 9},            {"transport", "fibers"}};
+    j["integrator"] = {
+        {"type", "volumetric"}, {"paths", 1000},       {"cell_voxels", 3}, {"sh_order", 4},
+        {"max_depth", 40},      {"roulette_depth", 5}, {"seed", 9},        {"transport", "fibers"}};
     const Scene s = parseScene(j, "scene.json", "/");
     EXPECT_EQ(s.integrator, Integrator::Volumetric);
     EXPECT_EQ(s.volumetric.paths, 1000u);
