@@ -1,4 +1,5 @@
 #include <hairvox/core/error.h>
+#include <hairvox/core/gauss_legendre.h>
 #include <hairvox/core/math.h>
 #include <hairvox/core/rng.h>
 #include <hairvox/core/sampling.h>
@@ -129,6 +130,65 @@ TEST(ScatteringKernel, AFiberOfAnyTangentScattersTheWorldFieldAsABruteForceQuadr
                 EXPECT_NEAR(got[ch], expected[ch], 0.01f * expected[ch] + 1e-4f)
                     << "channel " << ch << ", tangent " << u << ", toward " << w_o;
         }
+}
+
+/// The evaluation the rotation replaced, kept as its oracle: ∫ P_L[K] L̄ dω by
+/// the product rule of (L + 1) Gauss–Legendre nodes in s = ω·u by 2L + 1
+/// equal azimuths (exact for two functions of order L), in the frame whose e₁
+/// lies along ω_o's azimuth about u, where K's coefficients are the kernel's
+/// fiberFrameCoefficients.
+Rgb nodeOutgoing(const ScatteringKernel& kernel, const float* c, const Vec3f& u,
+                 const Vec3f& omega_o) {
+    const int order = kernel.order(), nc = SphericalHarmonics::coefficients(order);
+    const float s_o = glm::dot(omega_o, u);
+    const Vec3f e1 = glm::normalize(omega_o - s_o * u), e2 = glm::cross(u, e1);
+    std::vector<float> k(3 * std::size_t(nc));
+    kernel.fiberFrameCoefficients(s_o, k.data());
+    const quadrature::GaussLegendre gl(order + 1);
+    const int nPhi = 2 * order + 1;
+    Rgbd sum(0.0);
+    for (int q = 0; q < gl.order(); ++q)
+        for (int p = 0; p < nPhi; ++p) {
+            const double s = gl.node(q), r = std::sqrt(1.0 - s * s), phi = TwoPi * p / nPhi;
+            const Vec3f local(float(r * std::cos(phi)), float(r * std::sin(phi)), float(s));
+            const Y yl = harmonics(local, order),
+                    yw = harmonics(local.x * e1 + local.y * e2 + local.z * u, order);
+            for (int ch = 0; ch < 3; ++ch) {
+                double K = 0, Lbar = 0;
+                for (int i = 0; i < nc; ++i) {
+                    K += double(k[std::size_t(ch * nc + i)]) * double(yl[std::size_t(i)]);
+                    Lbar += double(c[ch * nc + i]) * double(yw[std::size_t(i)]);
+                }
+                sum[ch] += gl.weight(q) * (TwoPi / nPhi) * K * Lbar;
+            }
+        }
+    return Rgb(sum);
+}
+
+TEST(ScatteringKernel, TheRotatedCoefficientsGiveTheNodeEvaluation) {
+    FiberParams params;
+    params.sigma_a = FiberParams::sigmaFromMelanin(0.3f, 0.1f);
+    const MarschnerBcsdf bcsdf(params);
+    Pcg32 rng(11);
+    for (const int L : {3, SphericalHarmonics::kMaxOrder}) {
+        const ScatteringKernel kernel(bcsdf, L);
+        const int nc = SphericalHarmonics::coefficients(L);
+        for (int trial = 0; trial < 24; ++trial) {
+            // A random field: every coefficient of every band, about a mean of 1.
+            std::vector<float> c(3 * std::size_t(nc));
+            for (int ch = 0; ch < 3; ++ch)
+                for (int i = 0; i < nc; ++i)
+                    c[std::size_t(ch * nc + i)] = i == 0 ? 3.5f : rng.uniform(-0.3f, 0.3f);
+            const Vec3f u = uniformSphere(rng.uniformFloat(), rng.uniformFloat());
+            const Vec3f w_o = uniformSphere(rng.uniformFloat(), rng.uniformFloat());
+            const Rgb got = kernel.apply(c.data(), u, w_o);
+            const Rgb expected = nodeOutgoing(kernel, c.data(), u, w_o);
+            for (int ch = 0; ch < 3; ++ch)
+                EXPECT_NEAR(got[ch], expected[ch], 0.005f * std::abs(expected[ch]))
+                    << "order " << L << ", channel " << ch << ", tangent " << u << ", toward "
+                    << w_o;
+        }
+    }
 }
 
 TEST(ScatteringKernel, RotatingTheFiberTheFieldAndTheViewTogetherChangesNothing) {

@@ -3,6 +3,7 @@
 #include <hairvox/core/math.h>
 #include <hairvox/shading/marschner.h>
 #include <hairvox/volumetric/scattering_kernel.h>
+#include <hairvox/volumetric/sh_rotation.h>
 #include <hairvox/volumetric/spherical_harmonics.h>
 
 #include <tbb/parallel_for.h>
@@ -31,27 +32,15 @@ Vec3f local(float s, float c, float cosPhi, float sinPhi) {
 } // namespace
 
 ScatteringKernel::ScatteringKernel(const MarschnerBcsdf& bcsdf, int order)
-    : order_(order)
-    , nodesS_(order + 1)
-    , nodesPhi_(2 * order + 1) {
+    : order_(order) {
     if (order < 1 || order > SphericalHarmonics::kMaxOrder)
         throw InputError(strCat("volumetric: sh_order = ", order, ": expected an integer in [1, ",
                                 SphericalHarmonics::kMaxOrder, "]"));
-    const quadrature::GaussLegendre nodes(nodesS_);
-    for (int q = 0; q < nodesS_; ++q) {
-        s_.push_back(float(nodes.node(q)));
-        cosTheta_.push_back(float(cosFromSin(nodes.node(q))));
-    }
-    for (int p = 0; p < nodesPhi_; ++p) {
-        const double phi = TwoPi * p / nodesPhi_;
-        cosPhi_.push_back(float(std::cos(phi)));
-        sinPhi_.push_back(float(std::sin(phi)));
-    }
-    const int nc = SphericalHarmonics::coefficients(order);
+    const int nc = SphericalHarmonics::coefficients(order), ng = perChannel();
     const quadrature::GaussLegendre panel(kPanelPoints);
     const bool eccentric = bcsdf.params().eccentricity != 1.0f;
     const int twists = eccentric ? kTwistPoints : 1;
-    w_.assign(std::size_t(kRows) * std::size_t(nodesS_ * nodesPhi_), Rgb(0.0f));
+    g_.assign(std::size_t(kRows) * 3 * std::size_t(ng), 0.0f);
     tbb::parallel_for(0, kRows, [&](int j) {
         const double s_o = -1.0 + 2.0 * j / (kRows - 1);
         const auto theta_o = float(safeASin(s_o));
@@ -84,61 +73,75 @@ ScatteringKernel::ScatteringKernel(const MarschnerBcsdf& bcsdf, int order)
                 }
             }
         }
-        // W_jq = w_q · P_L[K_j](ω_q).
-        const double wPhi = TwoPi / nodesPhi_;
-        for (int q = 0; q < nodesS_; ++q)
-            for (int p = 0; p < nodesPhi_; ++p) {
-                SphericalHarmonics::evaluate(local(s_[std::size_t(q)], cosTheta_[std::size_t(q)],
-                                                   cosPhi_[std::size_t(p)],
-                                                   sinPhi_[std::size_t(p)]),
-                                             order, y.data());
-                Rgbd P(0.0);
-                for (int m = 0; m < nc; ++m)
-                    P += k[std::size_t(m)] * double(y[std::size_t(m)]);
-                w_[(std::size_t(j) * std::size_t(nodesS_) + std::size_t(q)) *
-                       std::size_t(nodesPhi_) +
-                   std::size_t(p)] = Rgb(P * (nodes.weight(q) * wPhi));
-            }
+        // G_lm = k_lm (m ≥ 0); the sin terms k_l,−m vanish by the evenness in φ.
+        float* row = g_.data() + std::size_t(j) * 3 * std::size_t(ng);
+        for (int l = 0; l <= order; ++l)
+            for (int m = 0; m <= l; ++m)
+                for (int ch = 0; ch < 3; ++ch)
+                    row[ch * ng + l * (l + 1) / 2 + m] =
+                        float(k[std::size_t(SphericalHarmonics::index(l, m))][ch]);
     });
 }
 
-Rgb ScatteringKernel::apply(const float* coefficients, const Vec3f& u, const Vec3f& omega_o) const {
-    const float s_o = std::clamp(glm::dot(omega_o, u), -1.0f, 1.0f);
-    // e₁ along ω_o's azimuth about u (any ⟂ direction when ω_o is along u).
-    Vec3f e1 = omega_o - s_o * u;
-    const float r = glm::length(e1);
-    Vec3f e2;
-    if (r > 1e-6f)
-        e1 /= r;
-    else
-        coordinateSystem(u, e1, e2);
-    e2 = glm::cross(u, e1);
-    const float p = (s_o + 1.0f) * 0.5f * float(kRows - 1);
+void ScatteringKernel::rows(float s_o, const float*& g0, const float*& g1, float& t) const {
+    const float p = (std::clamp(s_o, -1.0f, 1.0f) + 1.0f) * 0.5f * float(kRows - 1);
     const int j0 = std::min(int(p), kRows - 2);
-    const float t = p - float(j0);
-    const std::size_t perRow = std::size_t(nodesS_ * nodesPhi_);
-    const Rgb* w0 = w_.data() + std::size_t(j0) * perRow;
-    const Rgb* w1 = w0 + perRow;
-    const int nc = SphericalHarmonics::coefficients(order_);
-    std::array<float, SphericalHarmonics::kMaxCoefficients> y{};
-    Rgb out(0.0f);
-    for (int q = 0; q < nodesS_; ++q) {
-        const Vec3f along = s_[std::size_t(q)] * u;
-        const float c = cosTheta_[std::size_t(q)];
-        for (int ph = 0; ph < nodesPhi_; ++ph) {
-            const Vec3f omega =
-                along + c * (cosPhi_[std::size_t(ph)] * e1 + sinPhi_[std::size_t(ph)] * e2);
-            SphericalHarmonics::evaluate(omega, order_, y.data());
-            const std::size_t i = std::size_t(q * nodesPhi_ + ph);
-            const Rgb w = (1.0f - t) * w0[i] + t * w1[i];
-            for (int ch = 0; ch < 3; ++ch) {
-                const float* cc = coefficients + ch * nc;
-                float v = 0;
-                for (int m = 0; m < nc; ++m)
-                    v += cc[m] * y[std::size_t(m)];
-                out[ch] += w[ch] * v;
+    t = p - float(j0);
+    const std::size_t perRow = 3 * std::size_t(perChannel());
+    g0 = g_.data() + std::size_t(j0) * perRow;
+    g1 = g0 + perRow;
+}
+
+void ScatteringKernel::fiberFrameCoefficients(float s_o, float* k) const {
+    const float *g0, *g1;
+    float t;
+    rows(s_o, g0, g1, t);
+    const int nc = SphericalHarmonics::coefficients(order_), ng = perChannel();
+    for (int ch = 0; ch < 3; ++ch)
+        for (int l = 0; l <= order_; ++l)
+            for (int m = -l; m <= l; ++m) {
+                const int i = ch * ng + l * (l + 1) / 2 + std::abs(m);
+                k[ch * nc + SphericalHarmonics::index(l, m)] =
+                    m < 0 ? 0.0f : (1.0f - t) * g0[i] + t * g1[i];
             }
+}
+
+Rgb ScatteringKernel::apply(const float* coefficients, const Vec3f& u, const Vec3f& omega_o) const {
+    const int nc = SphericalHarmonics::coefficients(order_), ng = perChannel();
+    const ShFrameRotation frame(u, order_);
+    std::array<float, 3 * SphericalHarmonics::kMaxCoefficients> c;
+    frame.apply(coefficients, c.data(), 3);
+    // cos mφ_o, sin mφ_o from ω_o's azimuth about u (any when ω_o is along u: then K has no
+    // m > 0 terms).
+    const float x = glm::dot(omega_o, frame.e1()), y = glm::dot(omega_o, frame.e2());
+    const float r = std::sqrt(x * x + y * y);
+    const float cosPhi = r > 1e-7f ? x / r : 1.0f, sinPhi = r > 1e-7f ? y / r : 0.0f;
+    std::array<float, SphericalHarmonics::kMaxOrder + 1> cosM, sinM;
+    cosM[0] = 1;
+    sinM[0] = 0;
+    for (int m = 1; m <= order_; ++m) {
+        cosM[std::size_t(m)] =
+            cosM[std::size_t(m - 1)] * cosPhi - sinM[std::size_t(m - 1)] * sinPhi;
+        sinM[std::size_t(m)] =
+            sinM[std::size_t(m - 1)] * cosPhi + cosM[std::size_t(m - 1)] * sinPhi;
+    }
+    const float *g0, *g1;
+    float t;
+    rows(glm::dot(omega_o, u), g0, g1, t);
+    Rgb out(0.0f);
+    for (int ch = 0; ch < 3; ++ch) {
+        const float* cc = c.data() + ch * nc;
+        const float* a = g0 + ch * ng;
+        const float* b = g1 + ch * ng;
+        float sum = 0;
+        for (int l = 0; l <= order_; ++l) {
+            const int gl = l * (l + 1) / 2, il = l * l + l;
+            sum += ((1.0f - t) * a[gl] + t * b[gl]) * cc[il];
+            for (int m = 1; m <= l; ++m)
+                sum += ((1.0f - t) * a[gl + m] + t * b[gl + m]) *
+                       (cc[il + m] * cosM[std::size_t(m)] + cc[il - m] * sinM[std::size_t(m)]);
         }
+        out[ch] = sum;
     }
     return out;
 }

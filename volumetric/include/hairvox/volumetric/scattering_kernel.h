@@ -6,23 +6,27 @@
 // radiance L̄ of its cell is (docs/DESIGN.md §3, the renderer's convention)
 //     L_o(ω_o) = ∫ K(ω_i) L̄(ω_i) dω_i,   K(ω_i) = f_s(u; ω_i, ω_o) cos θ_i.
 // L̄ is held to SH order L (spherical_harmonics.h), so only the projection
-// P_L[K] of the kernel onto the same orders counts:
-//     L_o = ∫ P_L[K] L̄ dω,
-// and the product of two functions of order L is integrated exactly by a
-// product rule of (L + 1) Gauss–Legendre nodes in s = sin θ (about u) by
-// 2L + 1 equally spaced azimuths. In the frame (e₁, e₂, u) with e₁ along ω_o's
-// azimuth (φ_o = 0), P_L[K] depends on s_o = ω_o·u alone, so the kernel
-// tabulates, at R outgoing s_o (rows, read linearly between), the weights
-//     W_jq = w_q · P_L[K_j](ω_q)   (RGB; K_j at s_o of row j),
-// P_L[K_j] projected by a fine quadrature of f_s (Gauss–Legendre panels in s,
-// the midpoint rule over the period in φ; the cross-section's twist averaged
-// when the fiber is eccentric). A fragment then evaluates its cell's L̄ at
-// the nodes rotated into its own frame:
-//     L_o = Σ_q W_q(s_o) L̄(s_q u + c_q (cos φ_q e₁ + sin φ_q e₂)).
-// This is the rotation of L̄ into the fiber's frame followed by the
-// scattering matrix, done at the nodes instead of on the coefficients: exact
-// for the order held, whatever the angle between the fiber and its cell's
-// other fibers.
+// P_L[K] of the kernel onto the same orders counts: L_o = Σ_lm c_lm k_lm,
+// c and k the coefficients of L̄ and K in one basis. In the fiber's frame
+// (sh_rotation.h: e₁, e₂, u) f_s depends on the azimuths only through
+// φ_o − φ_i and is even in it (the twist of an eccentric cross-section
+// averaged), so K's projection there is diagonal in m:
+//     k'_l0 = G_l0(s_o),  k'_lm = G_lm(s_o) cos mφ_o,  k'_l,−m = G_lm(s_o) sin mφ_o
+// (m > 0; s_o = ω_o·u, φ_o ω_o's azimuth about u from e₁), G_lm the
+// coefficients of K at φ_o = 0. The kernel tabulates G (RGB, (L + 1)(L + 2)/2
+// values) at R outgoing s_o (rows, read linearly between), projected by a
+// fine quadrature of f_s (Gauss–Legendre panels in s, the midpoint rule over
+// the period in φ; the cross-section's twist averaged when the fiber is
+// eccentric). A fragment rotates its cell's coefficients into its own frame
+// (c' = C_F c, sh_rotation.h) and contracts:
+//     L_o = Σ_l [G_l0 c'_l0 + Σ_{m>0} G_lm (c'_lm cos mφ_o + c'_l,−m sin mφ_o)].
+// Moon, Walter & Marschner's rotation followed by their scattering matrix,
+// exact for the order held, whatever the angle between the fiber and its
+// cell's other fibers: 2·Σ(2l + 1)² multiply-adds a channel for the
+// rotation (half of them zeros skipped) and (L + 1)² for the contraction.
+// (Replaced: the same product evaluated at (L + 1) × (2L + 1) quadrature
+// nodes in the fragment's frame, an SH synthesis each — 38× the shading
+// time of the cell-frame design; docs/DESIGN.md §9.)
 #pragma once
 
 #include <hairvox/core/rgb.h>
@@ -48,12 +52,19 @@ public:
     /// 3·(L + 1)² floats).
     Rgb apply(const float* coefficients, const Vec3f& u, const Vec3f& omega_o) const;
 
+    /// K's SH coefficients in the fiber's frame at φ_o = 0 (k'_lm = G_lm(s_o)
+    /// for m ≥ 0, 0 for m < 0) into `k` (planar [channel][lm], 3·(L + 1)²
+    /// floats), read between the rows as apply() reads them.
+    void fiberFrameCoefficients(float s_o, float* k) const;
+
 private:
+    /// The two rows around s_o and the weight of the second.
+    void rows(float s_o, const float*& g0, const float*& g1, float& t) const;
+    /// Values a row holds per channel: G_lm for l ≤ L, 0 ≤ m ≤ l, at l(l + 1)/2 + m.
+    int perChannel() const { return (order_ + 1) * (order_ + 2) / 2; }
+
     int order_;
-    int nodesS_, nodesPhi_;
-    std::vector<float> s_, cosTheta_;    ///< per s-node: s_q, √(1 − s_q²)
-    std::vector<float> cosPhi_, sinPhi_; ///< per φ-node
-    std::vector<Rgb> w_;                 ///< [row][s-node][φ-node]: W_jq
+    std::vector<float> g_; ///< [row][channel][l(l + 1)/2 + m]: G_lm(s_o of the row)
 };
 
 } // namespace hairvox
