@@ -22,8 +22,8 @@
 //     L_o = Σ_l [G_l0 c'_l0 + Σ_{m>0} G_lm (c'_lm cos mφ_o + c'_l,−m sin mφ_o)].
 // Moon, Walter & Marschner's rotation followed by their scattering matrix,
 // exact for the order held, whatever the angle between the fiber and its
-// cell's other fibers: 2·Σ(2l + 1)² multiply-adds a channel for the
-// rotation (half of them zeros skipped) and (L + 1)² for the contraction.
+// cell's other fibers: ~500 multiply-adds a channel for the rotation at
+// L = 8 (sh_rotation.h) and (L + 1)² for the contraction.
 // (Replaced: the same product evaluated at (L + 1) × (2L + 1) quadrature
 // nodes in the fragment's frame, an SH synthesis each — 38× the shading
 // time of the cell-frame design; docs/DESIGN.md §9.)

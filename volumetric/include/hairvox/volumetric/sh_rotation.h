@@ -18,11 +18,12 @@
 //     (g∘R_z(θ))_lm = c_lm cos mθ + c_l,−m sin mθ,
 //     (g∘R_z(θ))_l,−m = −c_lm sin mθ + c_l,−m cos mθ   (m > 0).
 // C_Q's blocks are fixed: projected once, exactly, by a Gauss–Legendre ×
-// equal-azimuth product rule. Per rotation: 2·Σ(2l + 1)² multiply-adds per
-// channel for the two quarter turns (Σ = 969 at L = 8; half of C_Q's entries
-// are 0 and skipped), O(L²) for the z-rotations — exact to rounding, no table
-// over β, no recurrence per fragment (Ivanic & Ruedenberg 1996's would cost
-// as much to build the matrix as the quarter turns cost to apply).
+// equal-azimuth product rule; three quarters of their Σ(2l + 1)² entries are
+// 0 (at L = 8, 247 of 969 are not) and skipped. Per rotation: 2 × 247
+// multiply-adds per channel for the two quarter turns at L = 8, O(L²) for
+// the z-rotations — exact to rounding, no table over β, no recurrence per
+// fragment (Ivanic & Ruedenberg 1996's would cost more to build the dense
+// (2l + 1)² blocks of R_y(β) than the quarter turns cost to apply).
 #pragma once
 
 #include <hairvox/core/vecmath.h>
