@@ -52,7 +52,8 @@ struct SphericalHarmonics {
                 else if (l == m + 1)
                     q = float(2 * m + 1) * z * qmm;
                 else
-                    q = (float(2 * l - 1) * z * q1 - float(l + m - 1) * q2) / float(l - m);
+                    q = kRecurrence[std::size_t(index(l, m))][0] * z * q1 -
+                        kRecurrence[std::size_t(index(l, m))][1] * q2;
                 if (l > m) {
                     q2 = q1;
                     q1 = q;
@@ -85,6 +86,16 @@ private:
                 k[std::size_t(index(l, m))] =
                     float((m == 0 ? 1.0 : std::sqrt(2.0)) * normalisation(l, m));
         return k;
+    }();
+    /// (2l − 1)/(l − m) and (l + m − 1)/(l − m) at index(l, m), l ≥ m + 2: Q's
+    /// recurrence without a division per term.
+    static inline const std::array<std::array<float, 2>, kMaxCoefficients> kRecurrence = [] {
+        std::array<std::array<float, 2>, kMaxCoefficients> r{};
+        for (int l = 2; l <= kMaxOrder; ++l)
+            for (int m = 0; m <= l - 2; ++m)
+                r[std::size_t(index(l, m))] = {float(2 * l - 1) / float(l - m),
+                                               float(l + m - 1) / float(l - m)};
+        return r;
     }();
 };
 
