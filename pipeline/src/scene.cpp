@@ -4,6 +4,7 @@
 #include <hairvox/core/error.h>
 #include <hairvox/geometry/builtin_environment.h>
 #include <hairvox/pipeline/scene.h>
+#include <hairvox/volumetric/spherical_harmonics.h>
 
 #include <nlohmann/json.hpp>
 
@@ -669,15 +670,11 @@ Scene parseScene(const nlohmann::json& document, const std::string& sourceName,
             set("cell_voxels", volumetric, [&](const JsonValue& x) {
                 vol.cache.cellVoxels = static_cast<int>(x.integer(1, 16));
             });
-            set("theta_bins", volumetric, [&](const JsonValue& x) {
-                vol.cache.basis.thetaBins = static_cast<int>(x.integer(2, 64));
+            set("sh_order", volumetric, [&](const JsonValue& x) {
+                vol.cache.shOrder = static_cast<int>(x.integer(1, SphericalHarmonics::kMaxOrder));
             });
             set("transport", volumetric,
                 [&](const JsonValue& x) { vol.transport = x.oneOf(kVolumetricTransportNames); });
-            set("azimuthal_order", volumetric, [&](const JsonValue& x) {
-                vol.cache.basis.azimuthalOrder =
-                    static_cast<int>(x.integer(0, RadianceBasis::kMaxOrder));
-            });
             in.finish();
         }
     }

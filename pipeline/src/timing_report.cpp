@@ -164,16 +164,14 @@ void printTimingReport(std::ostream& os, const Scene& scene, const SceneRender& 
                           thousands(v.surfaceEvents).c_str(), v.deepestPath,
                           thousands(v.pathsAtDepthCap).c_str());
             row("multiple", r.times.multiple, line);
-            std::snprintf(line, sizeof(line),
-                          "%s cells of %.3g (%d x %d coefficients per channel), %s deposits; "
-                          "%llu MB held; trace %.3f s, scattering tables %.3f s",
-                          thousands(v.cells).c_str(),
-                          double(scene.volumetric.cache.cellVoxels) * r.voxelSize,
-                          scene.volumetric.cache.basis.thetaBins,
-                          scene.volumetric.cache.basis.coefficientsPerBin(),
-                          thousands(v.crossings).c_str(),
-                          static_cast<unsigned long long>(megabytes(v.bytes)), v.traceSeconds,
-                          v.finishSeconds);
+            std::snprintf(
+                line, sizeof(line),
+                "%s cells of %.3g (SH order %d, %d coefficients per channel), %s "
+                "deposits; %llu MB held; trace %.3f s, scattering kernels %.3f s",
+                thousands(v.cells).c_str(), double(scene.volumetric.cache.cellVoxels) * r.voxelSize,
+                scene.volumetric.cache.shOrder, scene.volumetric.cache.coefficients(),
+                thousands(v.crossings).c_str(), static_cast<unsigned long long>(megabytes(v.bytes)),
+                v.traceSeconds, v.finishSeconds);
             more(line);
         }
     }

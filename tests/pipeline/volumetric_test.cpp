@@ -52,27 +52,25 @@ std::string errorOf(const nlohmann::json& integrator) {
 
 TEST(Volumetric, SceneKeysAreReadAndCheckedPerIntegrator) {
     nlohmann::json j = nlohmann::json::parse(defaultSceneJson());
-    j["integrator"] = {{"type", "volumetric"},    {"paths", 1000},        {"cell_voxels", 3},
-                       {"theta_bins", 8},         {"azimuthal_order", 2}, {"max_depth", 40},
-                       {"roulette_depth", 5},     {"seed", 9},            {"transport", "fibers"}};
+    j["integrator"] = {
+        {"type", "volumetric"}, {"paths", 1000},       {"cell_voxels", 3}, {"sh_order", 4},
+        {"max_depth", 40},      {"roulette_depth", 5}, {"seed", 9},        {"transport", "fibers"}};
     const Scene s = parseScene(j, "scene.json", "/");
     EXPECT_EQ(s.integrator, Integrator::Volumetric);
     EXPECT_EQ(s.volumetric.paths, 1000u);
     EXPECT_EQ(s.volumetric.cache.cellVoxels, 3);
-    EXPECT_EQ(s.volumetric.cache.basis.thetaBins, 8);
-    EXPECT_EQ(s.volumetric.cache.basis.azimuthalOrder, 2);
+    EXPECT_EQ(s.volumetric.cache.shOrder, 4);
     EXPECT_EQ(s.volumetric.maxDepth, 40u);
     EXPECT_EQ(s.volumetric.rouletteDepth, 5u);
     EXPECT_EQ(s.volumetric.seed, 9u);
     EXPECT_EQ(s.volumetric.transport, VolumetricTransport::Fibers);
 
-    EXPECT_NE(errorOf({{"type", "volumetric"}, {"theta_bins", 1}})
-                  .find("/integrator/theta_bins: expected an integer in [2, 64], got 1"),
+    EXPECT_NE(errorOf({{"type", "volumetric"}, {"sh_order", 0}})
+                  .find("/integrator/sh_order: expected an integer in [1, 8], got 0"),
               std::string::npos);
     EXPECT_NE(errorOf({{"type", "volumetric"}, {"cell_voxels", 17}}).find("/integrator/cell_voxels"),
               std::string::npos);
-    EXPECT_NE(errorOf({{"type", "volumetric"}, {"azimuthal_order", 9}})
-                  .find("/integrator/azimuthal_order"),
+    EXPECT_NE(errorOf({{"type", "volumetric"}, {"sh_order", 9}}).find("/integrator/sh_order"),
               std::string::npos);
     EXPECT_NE(errorOf({{"type", "volumetric"}, {"paths_per_cell", -1}})
                   .find("/integrator/paths_per_cell"),
@@ -86,7 +84,7 @@ TEST(Volumetric, SceneKeysAreReadAndCheckedPerIntegrator) {
     EXPECT_NE(errorOf({{"type", "volumetric"}, {"spp", 4}})
                   .find("/integrator/spp: applies to the \"path\" integrator only"),
               std::string::npos);
-    EXPECT_NE(errorOf({{"type", "path"}, {"theta_bins", 8}})
+    EXPECT_NE(errorOf({{"type", "path"}, {"sh_order", 8}})
                   .find("applies to the \"volumetric\" integrator only"),
               std::string::npos);
 }

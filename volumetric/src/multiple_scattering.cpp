@@ -286,7 +286,7 @@ void VolumetricSettings::validate() const {
 }
 
 void VolumetricSettings::hashInto(Hasher& h) const {
-    h.value(paths).value(pathsPerCell).value(cache.basis.thetaBins).value(cache.basis.azimuthalOrder);
+    h.value(paths).value(pathsPerCell).value(cache.shOrder);
     h.value(cache.cellVoxels).value(maxDepth).value(rouletteDepth).value(seed).value(transport);
 }
 
@@ -409,12 +409,9 @@ MultipleScatteringSolution solveMultipleScattering(const VolumetricScene& scene,
 
     const auto finishStart = Clock::now();
     std::vector<ScatteringKernel> kernels;
-    for (const FiberParams& fiber : scene.fibers) {
-        const MarschnerBcsdf bcsdf(fiber);
-        kernels.emplace_back(bcsdf, settings.cache.basis, KernelLobes::Backward);
-        kernels.emplace_back(bcsdf, settings.cache.basis, KernelLobes::Forward);
-    }
-    cache.finish(kernels);
+    for (const FiberParams& fiber : scene.fibers)
+        kernels.emplace_back(MarschnerBcsdf(fiber), settings.cache.shOrder);
+    cache.finish(std::move(kernels));
     stats.finishSeconds = secondsSince(finishStart);
     stats.bytes = cache.memoryBytes() + (out.surfaces ? out.surfaces->memoryBytes() : 0);
     return out;

@@ -1,16 +1,15 @@
-#include <hairvox/volumetric/radiance_cache.h>
-
 #include <hairvox/core/error.h>
 #include <hairvox/core/grid_traversal.h>
 #include <hairvox/core/math.h>
+#include <hairvox/volumetric/radiance_cache.h>
+#include <hairvox/volumetric/spherical_harmonics.h>
 #include <hairvox/voxelize/fiber_grid.h>
-
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 namespace hairvox {
 
@@ -18,9 +17,6 @@ namespace {
 
 /// Cells of the dense index at most (4 GiB of int32).
 constexpr std::uint64_t kMaxIndexCells = 1ull << 30;
-/// A frame needs at least this share of coherent length (|Σλo| / Σλ) in its
-/// cell, or it is taken from the 3³ neighbourhood.
-constexpr double kMinCoherence = 0.05;
 
 /// The box (first cell, cells a side) of the cells holding the grid's blocks.
 std::pair<glm::ivec3, glm::ivec3> cellBox(const FiberGrid& grid, int m) {
@@ -42,19 +38,21 @@ std::uint64_t boxCells(const glm::ivec3& dims) {
 } // namespace
 
 void RadianceCacheSettings::validate() const {
-    basis.validate();
+    if (shOrder < 1 || shOrder > SphericalHarmonics::kMaxOrder)
+        throw InputError(strCat("volumetric: sh_order = ", shOrder, ": expected an integer in [1, ",
+                                SphericalHarmonics::kMaxOrder, "]"));
     if (cellVoxels < 1 || cellVoxels > 16)
-        throw InputError(strCat("volumetric: cell_voxels = ", cellVoxels,
-                                ": expected an integer in [1, 16]"));
+        throw InputError(
+            strCat("volumetric: cell_voxels = ", cellVoxels, ": expected an integer in [1, 16]"));
 }
 
 std::ostream& operator<<(std::ostream& os, const RadianceCacheSettings& s) {
-    return os << "RadianceCacheSettings(" << s.basis << ", cellVoxels=" << s.cellVoxels << ")";
+    return os << "RadianceCacheSettings(shOrder=" << s.shOrder << ", cellVoxels=" << s.cellVoxels
+              << ")";
 }
 
 std::uint64_t RadianceCache::estimateBytes(const FiberGrid& grid,
-                                           const RadianceCacheSettings& settings,
-                                           std::size_t types) {
+                                           const RadianceCacheSettings& settings) {
     if (grid.blocks.empty())
         return 0;
     const int m = settings.cellVoxels;
@@ -63,74 +61,50 @@ std::uint64_t RadianceCache::estimateBytes(const FiberGrid& grid,
     // Occupied cells at most: one per active voxel, or the whole box.
     const std::uint64_t cells = std::min<std::uint64_t>(grid.activeVoxelCount(), boxCells(dims));
     const std::uint64_t perCell =
-        4 * 3 * std::uint64_t(settings.basis.coefficients()) * std::max<std::size_t>(1, types) +
-        sizeof(FiberFrame) + sizeof(glm::ivec3) + sizeof(float);
+        4 * 3 * std::uint64_t(settings.coefficients()) + sizeof(glm::ivec3) + sizeof(float);
     return boxCells(dims) * 4 + cells * perCell;
 }
 
 RadianceCache::RadianceCache(const FiberGrid& grid, const RadianceCacheSettings& settings,
                              std::uint64_t memoryBudget)
-    : settings_(settings)
-    , types_(grid.fiberTypeCount()) {
+    : settings_(settings) {
     settings.validate();
     if (grid.blocks.empty())
         return;
-    const std::uint64_t estimate = estimateBytes(grid, settings, types_);
+    const std::uint64_t estimate = estimateBytes(grid, settings);
     const int m = settings.cellVoxels;
     const auto [lo, dims] = cellBox(grid, m);
     if (estimate > memoryBudget || boxCells(dims) > kMaxIndexCells)
-        throw InputError(strCat(
-            "volumetric: the radiance cache of ", dims.x, " x ", dims.y, " x ", dims.z,
-            " cells of ", m, " voxels would need about ", (estimate + (1ull << 20) - 1) >> 20,
-            " MiB, over the ", memoryBudget >> 20, " MiB the render can give it; raise "
-            "integrator.cell_voxels or the voxel size, or lower integrator.theta_bins / "
-            "azimuthal_order"));
+        throw InputError(
+            strCat("volumetric: the radiance cache of ", dims.x, " x ", dims.y, " x ", dims.z,
+                   " cells of ", m, " voxels would need about ",
+                   (estimate + (1ull << 20) - 1) >> 20, " MiB, over the ", memoryBudget >> 20,
+                   " MiB the render can give it; raise "
+                   "integrator.cell_voxels or the voxel size, or lower integrator.sh_order"));
     grid_ = CellGrid(float(grid.info.voxelSize), m, lo, dims);
-    const auto boxIndex = [&](const glm::ivec3& c) { return std::size_t(grid_.boxIndex(c)); };
+    const auto boxIndex = [&](const glm::ivec3& c) {
+        return std::size_t(grid_.boxIndex(c));
+    };
     const auto cellOfVoxel = [&](const openvdb::Coord& v) {
         return grid_.cellOfVoxel(glm::ivec3(v.x(), v.y(), v.z()));
     };
 
     // The cells holding fibers, in the order of their box index.
     std::vector<std::uint8_t> mark(grid_.boxCells(), 0);
-    grid.forEachVoxel([&](std::size_t, const openvdb::Coord& v) { mark[boxIndex(cellOfVoxel(v))] = 1; });
+    grid.forEachVoxel(
+        [&](std::size_t, const openvdb::Coord& v) { mark[boxIndex(cellOfVoxel(v))] = 1; });
     for (const std::size_t i : grid_.makePresent(mark))
         cells_.push_back(grid_.cellOfBoxIndex(i));
 
-    // Λ and the frames from the fibers' length and mean tangents.
-    std::vector<Vec3d> sumO(cells_.size(), Vec3d(0.0));
+    // Λ from the fibers' length.
     std::vector<double> sumL(cells_.size(), 0.0);
     grid.forEachVoxel([&](std::size_t v, const openvdb::Coord& ijk) {
-        const auto slot = std::size_t(grid_.slotOfCell(cellOfVoxel(ijk)));
-        const openvdb::Vec3s& o = grid.orientation[v];
-        sumO[slot] += double(grid.density[v]) * Vec3d(o.x(), o.y(), o.z());
-        sumL[slot] += double(grid.density[v]);
+        sumL[std::size_t(grid_.slotOfCell(cellOfVoxel(ijk)))] += double(grid.density[v]);
     });
-    frames_.resize(cells_.size());
     fiberLength_.resize(cells_.size());
     const double h = double(grid_.voxelSize()), voxelVolume = h * h * h;
-    for (std::size_t s = 0; s < cells_.size(); ++s) {
+    for (std::size_t s = 0; s < cells_.size(); ++s)
         fiberLength_[s] = float(sumL[s] * voxelVolume);
-        Vec3d o = sumO[s];
-        double l = sumL[s];
-        if (glm::length(o) <= kMinCoherence * l || l == 0) {
-            o = Vec3d(0.0);
-            l = 0;
-            for (int dx = -1; dx <= 1; ++dx)
-                for (int dy = -1; dy <= 1; ++dy)
-                    for (int dz = -1; dz <= 1; ++dz) {
-                        const std::int64_t n = grid_.slotOfCell(cells_[s] + glm::ivec3(dx, dy, dz));
-                        if (n >= 0) {
-                            o += sumO[std::size_t(n)];
-                            l += sumL[std::size_t(n)];
-                        }
-                    }
-        }
-        const Vec3f axis = glm::length(o) > kMinCoherence * l && l > 0
-                               ? Vec3f(glm::normalize(o))
-                               : Vec3f(0.0f, 1.0f, 0.0f);
-        frames_[s] = FiberFrame::about(axis);
-    }
 
     coefficients_.assign(cells_.size() * floatsPerCell(), 0.0f);
 }
@@ -146,13 +120,9 @@ Bounds3f RadianceCache::bounds() const {
 }
 
 std::uint64_t RadianceCache::memoryBytes() const {
-    std::uint64_t bytes = grid_.memoryBytes() +
-                          cells_.capacity() * sizeof(glm::ivec3) +
-                          frames_.capacity() * sizeof(FiberFrame) +
+    std::uint64_t bytes = grid_.memoryBytes() + cells_.capacity() * sizeof(glm::ivec3) +
                           fiberLength_.capacity() * sizeof(float) +
                           coefficients_.size() * sizeof(float);
-    for (const auto& o : outgoing_)
-        bytes += o.size() * sizeof(float);
     return bytes;
 }
 
@@ -160,108 +130,70 @@ std::int64_t RadianceCache::slotOfVoxel(const glm::ivec3& v) const {
     return grid_.slotOfCell(grid_.cellOfVoxel(v));
 }
 
-void RadianceCache::deposit(std::uint32_t slot, const Vec3f& omega_i, const Rgb& power) {
-    const RadianceBasis& basis = settings_.basis;
-    const AzimuthalHarmonics h =
-        AzimuthalHarmonics::of(omega_i, frames_[slot], basis.azimuthalOrder);
-    const int perBin = basis.coefficientsPerBin();
-    // The projection's normalisation: a_0 by 2πΔs, a_k and b_k by πΔs; and
-    // the fiber average's, by Λ.
-    const float inv = float(InvPi) / (basis.binWidth() * fiberLength_[slot]);
-    float* c = coefficients_.data() + std::size_t(slot) * floatsPerCell() +
-               std::size_t(basis.bin(h.s)) * std::size_t(perBin);
-    const std::size_t channel = std::size_t(basis.coefficients());
+void RadianceCache::deposit(std::uint32_t slot, const Vec3f& omega_i, const Rgb& sample) {
+    const int nc = settings_.coefficients();
+    std::array<float, SphericalHarmonics::kMaxCoefficients> y;
+    SphericalHarmonics::evaluate(omega_i, settings_.shOrder, y.data());
+    float* c = coefficients_.data() + std::size_t(slot) * floatsPerCell();
+    const float inv = 1.0f / fiberLength_[slot];
     for (int ch = 0; ch < 3; ++ch) {
-        const float w = power[ch] * inv;
-        float* cc = c + std::size_t(ch) * channel;
-        cc[0] += 0.5f * w;
-        for (int m = 1; m < perBin; ++m)
-            cc[m] += w * h.harmonic[std::size_t(m)];
+        const float w = sample[ch] * inv;
+        float* cc = c + ch * nc;
+        for (int m = 0; m < nc; ++m)
+            cc[m] += w * y[std::size_t(m)];
     }
 }
 
-void RadianceCache::finish(const std::vector<ScatteringKernel>& kernels) {
-    if (kernels.size() < 2 * types_)
-        throw std::invalid_argument(
-            "RadianceCache::finish: a backward and a forward kernel per fiber type are needed");
-    const std::size_t n = floatsPerCell();
-    outgoing_.resize(2 * types_ - 1);
-    for (auto& o : outgoing_)
-        o.resize(cells_.size() * n); // every element written below
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells_.size(), 256),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                          std::vector<float> incident(n);
-                          for (std::size_t s = r.begin(); s != r.end(); ++s) {
-                              float* c = coefficients_.data() + s * n;
-                              std::copy(c, c + n, incident.begin());
-                              for (std::size_t k = 2 * types_; k-- > 0;)
-                                  kernels[k].apply(incident, {table(k) + s * n, n});
-                          }
-                      });
+void RadianceCache::finish(std::vector<ScatteringKernel> kernels) {
+    for (const ScatteringKernel& k : kernels)
+        if (k.order() != settings_.shOrder)
+            throw std::invalid_argument("RadianceCache::finish: a kernel of another SH order");
+    kernels_ = std::move(kernels);
     finished_ = true;
+}
+
+bool RadianceCache::blend(const Vec3f& x, float* out) const {
+    const std::size_t n = floatsPerCell();
+    std::fill(out, out + n, 0.0f);
+    const float weights = grid_.forEachAround(x, [&](std::size_t slot, float w) {
+        const float* c = coefficients_.data() + slot * n;
+        for (std::size_t i = 0; i < n; ++i)
+            out[i] += w * c[i];
+    });
+    if (!(weights > 0))
+        return false;
+    for (std::size_t i = 0; i < n; ++i)
+        out[i] /= weights;
+    return true;
 }
 
 Rgb RadianceCache::outgoing(const Vec3f& x, const Vec3f& u, const Vec3f& omega_o,
                             std::size_t type) const {
     if (cells_.empty())
         return Rgb(0.0f);
-    const RadianceBasis& basis = settings_.basis;
-    const int bins = basis.thetaBins, perBin = basis.coefficientsPerBin();
-    const std::size_t channel = std::size_t(basis.coefficients()), n = floatsPerCell();
-    const float* backward = table(2 * type);
-    const float* forward = table(2 * type + 1);
-    // A table's value toward the direction with harmonics h: between the
-    // tabulated s_o (the bins' centres), clamped at the ends.
-    const auto read = [&](const float* cell, const AzimuthalHarmonics& h, Rgb& out, float w) {
-        const float p = std::clamp((h.s + 1.0f) / basis.binWidth() - 0.5f, 0.0f, float(bins - 1));
-        const int j0 = std::min(int(p), bins - 2), j1 = j0 + 1;
-        const float tj = p - float(j0);
-        for (int ch = 0; ch < 3; ++ch) {
-            const float* a = cell + std::size_t(ch) * channel + std::size_t(j0) * std::size_t(perBin);
-            const float* b = cell + std::size_t(ch) * channel + std::size_t(j1) * std::size_t(perBin);
-            float v = 0;
-            for (int m = 0; m < perBin; ++m)
-                v += ((1.0f - tj) * a[m] + tj * b[m]) * h.harmonic[std::size_t(m)];
-            out[ch] += w * v;
-        }
-    };
-    Rgb sum(0.0f);
-    const float weights = grid_.forEachAround(x, [&](std::size_t slot, float w) {
-        const FiberFrame& frame = frames_[slot];
-        const std::size_t offset = slot * n;
-        // Backward lobes in the fragment's own frame, the forward lobe in the
-        // cell's (the file comment).
-        read(backward + offset,
-             AzimuthalHarmonics::of(omega_o, FiberFrame::along(u, frame), basis.azimuthalOrder),
-             sum, w);
-        read(forward + offset, AzimuthalHarmonics::of(omega_o, frame, basis.azimuthalOrder), sum, w);
-    });
-    if (!(weights > 0))
+    if (type >= kernels_.size())
+        throw std::invalid_argument("RadianceCache::outgoing: no kernel for the fiber type");
+    std::array<float, 3 * SphericalHarmonics::kMaxCoefficients> c;
+    if (!blend(x, c.data()))
         return Rgb(0.0f);
-    sum /= weights;
+    const Rgb sum = kernels_[type].apply(c.data(), u, omega_o);
     return {std::max(0.0f, sum.r), std::max(0.0f, sum.g), std::max(0.0f, sum.b)};
 }
 
 Rgb RadianceCache::incident(const Vec3f& x, const Vec3f& omega_i) const {
-    if (cells_.empty() || finished_)
+    if (cells_.empty())
         return Rgb(0.0f);
-    const RadianceBasis& basis = settings_.basis;
-    const int perBin = basis.coefficientsPerBin();
+    std::array<float, 3 * SphericalHarmonics::kMaxCoefficients> c;
+    if (!blend(x, c.data()))
+        return Rgb(0.0f);
+    std::array<float, SphericalHarmonics::kMaxCoefficients> y;
+    SphericalHarmonics::evaluate(omega_i, settings_.shOrder, y.data());
+    const int nc = settings_.coefficients();
     Rgb sum(0.0f);
-    const float weights = grid_.forEachAround(x, [&](std::size_t slot, float w) {
-        const AzimuthalHarmonics h =
-            AzimuthalHarmonics::of(omega_i, frames_[slot], basis.azimuthalOrder);
-        const float* c = coefficients_.data() + slot * floatsPerCell() +
-                         std::size_t(basis.bin(h.s)) * std::size_t(perBin);
-        for (int ch = 0; ch < 3; ++ch) {
-            float v = 0;
-            for (int m = 0; m < perBin; ++m)
-                v += c[std::size_t(ch) * std::size_t(basis.coefficients()) + std::size_t(m)] *
-                     h.harmonic[std::size_t(m)];
-            sum[ch] += w * v;
-        }
-    });
-    return weights > 0 ? sum / weights : Rgb(0.0f);
+    for (int ch = 0; ch < 3; ++ch)
+        for (int m = 0; m < nc; ++m)
+            sum[ch] += c[std::size_t(ch * nc + m)] * y[std::size_t(m)];
+    return sum;
 }
 
 std::ostream& operator<<(std::ostream& os, const RadianceCache& c) {

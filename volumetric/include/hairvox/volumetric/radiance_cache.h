@@ -1,6 +1,6 @@
 // hairvox volumetric: the radiance cache — light that has scattered at least
 // once, per cell of a coarse grid over the hair, as the fibers there receive
-// it (radiance_basis.h); what the volumetric integrator's fragments read
+// it (spherical_harmonics.h); what the volumetric integrator's fragments read
 // their multiple scattering from (docs/DESIGN.md §9).
 //
 // Cells. A cell is m × m × m voxels of the fiber grid (m = cellVoxels;
@@ -11,46 +11,37 @@
 // the default scene: 0.073 / 0.061 rel L1 against 0.072 / 0.056 at 0.6M /
 // 1.5M paths. The blur costs more than the noise it removes.)
 //
-// Frames. Each cell has one frame (FiberFrame::about its fibers' mean
-// tangent, the length-weighted Σ_v λ_v E_v[u], or the 3³ neighbourhood's
-// where that cancels, or +y); incident radiance is expanded in it: bins of
-// s = ω_i·axis and azimuthal harmonics about the axis (radiance_basis.h).
+// Basis. Each cell holds its incident radiance in real spherical harmonics
+// to order L (`sh_order`) in the world frame (spherical_harmonics.h; Moon,
+// Walter & Marschner 2008): one basis for every cell, so the eight cells
+// around a point blend coefficient by coefficient, and a fiber of any
+// tangent reads the field correctly. (Replaced: a frame per cell about its
+// fibers' mean tangent, bins of s × azimuthal harmonics, and the scattering
+// applied about that mean — on curly hair, where a cell holds fibers of every
+// azimuth about a helix's axis, it over-counted by a third at depth 2;
+// docs/DESIGN.md §9 has the measurements.)
 //
 // Incident radiance. A fragment lies on a fiber, so what it needs of a cell
 // is the radiance averaged over the cell's fibers, L̄(ω) = ∫ λ L(x, ω) dV / Λ,
 // Λ = ∫ λ dV = Σ_v λ_v h³ the cell's fiber length. deposit() adds one sample
 // of Λ·L̄ (radiance × solid angle × fiber length: a flight's power times the
 // fiber length it swept, Φ·∫λ dt, the track-length estimator of
-// multiple_scattering.h) and divides by Λ. The fibers' average rather than
-// the volume's: a cell half inside the head, or half beyond the hair's
-// surface, would otherwise mix in the radiance of space no fiber sees.
+// multiple_scattering.h) and divides by Λ: c_lm += sample·Y_lm(ω_i)/Λ. The
+// fibers' average rather than the volume's: a cell half inside the head, or
+// half beyond the hair's surface, would otherwise mix in the radiance of
+// space no fiber sees.
 //
-// Outgoing radiance: the lobes split by where their shape comes from.
-// finish() applies each fiber type's two scattering kernels
-// (scattering_kernel.h) to every cell's incident coefficients: its backward
-// lobes (R and TRT) and its forward lobe (TT), into two tables per type.
-// outgoing() reads them at a fragment of tangent u toward ω_o: trilinear
-// between the 8 cell centres around x (cells without fibers left out and
-// the weights renormalised), linearly between the tabulated s_o, the
-// backward table in the fragment's own frame (FiberFrame::along(u, cell
-// frame): s_o = ω_o·u) and the forward table in the cell's frame. R and TRT
-// leave a fiber in a cone about its own tangent, a few degrees wide, so the
-// fragment's inclination decides where they go; TT continues the light
-// through the lock, which the cell's mean orientation describes better than
-// one fiber does. Measured on the default scene against the path tracer
-// (docs/DESIGN.md §9), per light: every lobe from the cell's frame read at
-// the fragment's inclination put +5% into the back light's multiple
-// scattering, read at the cell's own inclination −5%; each fragment's own
-// f_s integrated against the cell's field, fixed in the world, +14% into
-// the key light's. With the split, the multiple layer is −4% of the path
-// tracer's and the hair's radiance −2%.
+// Outgoing radiance. outgoing() blends the coefficients of the 8 cells
+// around x trilinearly (cells without fibers left out and the weights
+// renormalised) and applies the fragment's own fiber type's scattering
+// kernel about the fragment's own tangent (scattering_kernel.h): every lobe
+// in the fiber's frame, exact for the order held.
 #pragma once
 
 #include <hairvox/core/large_array.h>
 #include <hairvox/core/rgb.h>
 #include <hairvox/core/vecmath.h>
 #include <hairvox/volumetric/cell_grid.h>
-#include <hairvox/volumetric/radiance_basis.h>
 #include <hairvox/volumetric/scattering_kernel.h>
 
 #include <cstdint>
@@ -62,8 +53,10 @@ namespace hairvox {
 struct FiberGrid;
 
 struct RadianceCacheSettings {
-    RadianceBasis basis;
+    int shOrder = 8;    ///< L: SH orders held, [1, 8]
     int cellVoxels = 2; ///< m: fiber-grid voxels per cell side, [1, 16]
+
+    int coefficients() const { return (shOrder + 1) * (shOrder + 1); }
 
     void validate() const;
 };
@@ -72,16 +65,14 @@ std::ostream& operator<<(std::ostream& os, const RadianceCacheSettings& s);
 
 class RadianceCache {
 public:
-    /// The cells of `grid` (see above), each with its frame and zeroed
-    /// coefficients. Throws InputError if the estimated memory exceeds
-    /// `memoryBudget` bytes (the message states the estimate).
+    /// The cells of `grid` (see above), each with zeroed coefficients. Throws InputError if the
+    /// estimated memory exceeds `memoryBudget` bytes (the message states the estimate).
     RadianceCache(const FiberGrid& grid, const RadianceCacheSettings& settings,
                   std::uint64_t memoryBudget);
 
-    /// Bytes the cache of `grid` would hold with `types` fiber types
-    /// (incident and outgoing coefficients, index, frames).
-    static std::uint64_t estimateBytes(const FiberGrid& grid, const RadianceCacheSettings& settings,
-                                       std::size_t types);
+    /// Bytes the cache of `grid` would hold (coefficients, index, Λ).
+    static std::uint64_t estimateBytes(const FiberGrid& grid,
+                                       const RadianceCacheSettings& settings);
 
     const RadianceCacheSettings& settings() const { return settings_; }
     std::size_t cellCount() const { return cells_.size(); }
@@ -97,14 +88,13 @@ public:
 
     /// Adds to the cell's incident radiance a sample of Λ·L̄ (radiance ×
     /// solid angle × fiber length) arriving from unit ω_i (pointing away from
-    /// the cell, toward where the light comes from): sample/Λ in the basis,
-    /// in the cell's frame. Not thread-safe for one slot.
+    /// the cell, toward where the light comes from): sample/Λ in the basis.
+    /// Not thread-safe for one slot.
     void deposit(std::uint32_t slot, const Vec3f& omega_i, const Rgb& sample);
 
-    /// Turns every cell's incident radiance into outgoing radiance with the
-    /// kernels of each fiber type t: kernels[2t] its backward lobes (R and
-    /// TRT), kernels[2t + 1] its forward lobe (TT). In parallel.
-    void finish(const std::vector<ScatteringKernel>& kernels);
+    /// Ends the deposits; `kernels[t]` is fiber type t's scattering kernel
+    /// (of the cache's SH order).
+    void finish(std::vector<ScatteringKernel> kernels);
     bool finished() const { return finished_; }
 
     /// The radiance a fiber of type `type` and unit tangent u at x sends
@@ -112,39 +102,29 @@ public:
     /// cells. Needs finish().
     Rgb outgoing(const Vec3f& x, const Vec3f& u, const Vec3f& omega_o, std::size_t type) const;
     /// The incident radiance L̄(x, ω_i) the fibers at x receive (trilinear
-    /// between the cells' expansions), before finish():
-    /// for tests and plots.
+    /// between the cells' expansions): for tests and plots.
     Rgb incident(const Vec3f& x, const Vec3f& omega_i) const;
 
     /// The slot of the cell holding world point x, or -1.
     std::int64_t slotAt(const Vec3f& x) const { return grid_.slotAt(x); }
-    /// The cell's reference frame: its fibers' mean tangent, and the origin
-    /// of the azimuths.
-    const FiberFrame& frame(std::size_t slot) const { return frames_[slot]; }
     /// The world position of a cell's centre.
     Vec3f cellCentre(std::size_t slot) const { return grid_.centre(cells_[slot]); }
     /// Λ, the cell's fiber length (world units).
     float fiberLength(std::size_t slot) const { return fiberLength_[slot]; }
 
 private:
-    std::size_t floatsPerCell() const { return 3 * std::size_t(settings_.basis.coefficients()); }
+    std::size_t floatsPerCell() const { return 3 * std::size_t(settings_.coefficients()); }
+    /// The coefficients blended trilinearly over the cells around x into
+    /// `out` (floatsPerCell() floats); false where no cell is.
+    bool blend(const Vec3f& x, float* out) const;
 
     RadianceCacheSettings settings_;
-    std::size_t types_ = 1;
     CellGrid grid_;                  ///< the box of cells and the slots of those with fibers
     std::vector<glm::ivec3> cells_;  ///< per slot
-    std::vector<FiberFrame> frames_;  ///< per slot
-    std::vector<float> fiberLength_;  ///< per slot: Λ
-    /// Outgoing table k (2·type + 0 backward, + 1 forward), per slot.
-    float* table(std::size_t k) { return k == 0 ? coefficients_.data() : outgoing_[k - 1].data(); }
-    const float* table(std::size_t k) const {
-        return k == 0 ? coefficients_.data() : outgoing_[k - 1].data();
-    }
-
-    /// Per slot [channel][bin][coefficient]: incident radiance until finish(),
-    /// then table 0 (type 0's backward lobes); tables 1.. in `outgoing_`.
+    std::vector<float> fiberLength_; ///< per slot: Λ
+    /// Per slot [channel][lm]: L̄'s SH coefficients.
     LargeVector<float> coefficients_;
-    std::vector<LargeVector<float>> outgoing_;
+    std::vector<ScatteringKernel> kernels_; ///< per fiber type, after finish()
     bool finished_ = false;
 };
 

@@ -1,62 +1,70 @@
-// hairvox volumetric: a fiber's scattering function projected onto the
-// radiance basis (radiance_basis.h) — Moon, Walter & Marschner 2008's
-// "scattering matrix", in the fiber's own frame.
+// hairvox volumetric: a fiber's scattering applied, in the fiber's own frame,
+// to radiance held in world-frame spherical harmonics — Moon, Walter &
+// Marschner 2008's "scattering matrix" (docs/DESIGN.md §9).
 //
-// The radiance a fiber of tangent ū sends toward ω_o from incident radiance L
-// is (docs/DESIGN.md §3, the renderer's convention)
-//     L_o(ω_o) = ∫ f_s(ω_i, ω_o) cos θ_i L(ω_i) dω_i,   dω_i = ds_i dφ_i.
-// With L in the basis and f_s even in Δφ = φ_o − φ_i (Marschner's N_p, with
-// the cross-section's orientation averaged out), the φ integral diagonalises:
-//     L_o(θ_o, φ_o) = Σ_i [a_i0 Ĝ_i0(θ_o) + Σ_k (a_ik cos kφ_o + b_ik sin kφ_o) Ĝ_ik(θ_o)],
-//     Ĝ_ik(θ_o) = ∫_{bin i} ds_i ∫_{−π}^{π} f_s(θ_i, θ_o, Δφ) cos θ_i cos(kΔφ) dΔφ   (RGB).
-// The kernel tabulates Ĝ at N_θ outgoing inclinations, the bins' centres in
-// s_o = sin θ_o (an outgoing radiance is then a basis-shaped table that a
-// lookup interpolates linearly in s_o), by Gauss–Legendre quadrature over each
-// bin (8 points) and the midpoint rule over the period in Δφ (256 points;
-// spectrally accurate for a periodic integrand).
+// The radiance a fiber of tangent u sends toward ω_o from the incident
+// radiance L̄ of its cell is (docs/DESIGN.md §3, the renderer's convention)
+//     L_o(ω_o) = ∫ K(ω_i) L̄(ω_i) dω_i,   K(ω_i) = f_s(u; ω_i, ω_o) cos θ_i.
+// L̄ is held to SH order L (spherical_harmonics.h), so only the projection
+// P_L[K] of the kernel onto the same orders counts: L_o = Σ_lm c_lm k_lm,
+// c and k the coefficients of L̄ and K in one basis. In the fiber's frame
+// (sh_rotation.h: e₁, e₂, u) f_s depends on the azimuths only through
+// φ_o − φ_i and is even in it (the twist of an eccentric cross-section
+// averaged), so K's projection there is diagonal in m:
+//     k'_l0 = G_l0(s_o),  k'_lm = G_lm(s_o) cos mφ_o,  k'_l,−m = G_lm(s_o) sin mφ_o
+// (m > 0; s_o = ω_o·u, φ_o ω_o's azimuth about u from e₁), G_lm the
+// coefficients of K at φ_o = 0. The kernel tabulates G (RGB, (L + 1)(L + 2)/2
+// values) at R outgoing s_o (rows, read linearly between), projected by a
+// fine quadrature of f_s (Gauss–Legendre panels in s, the midpoint rule over
+// the period in φ; the cross-section's twist averaged when the fiber is
+// eccentric). A fragment rotates its cell's coefficients into its own frame
+// (c' = C_F c, sh_rotation.h) and contracts:
+//     L_o = Σ_l [G_l0 c'_l0 + Σ_{m>0} G_lm (c'_lm cos mφ_o + c'_l,−m sin mφ_o)].
+// Moon, Walter & Marschner's rotation followed by their scattering matrix,
+// exact for the order held, whatever the angle between the fiber and its
+// cell's other fibers: ~500 multiply-adds a channel for the rotation at
+// L = 8 (sh_rotation.h) and (L + 1)² for the contraction.
+// (Replaced: the same product evaluated at (L + 1) × (2L + 1) quadrature
+// nodes in the fragment's frame, an SH synthesis each — 38× the shading
+// time of the cell-frame design; docs/DESIGN.md §9.)
 #pragma once
 
 #include <hairvox/core/rgb.h>
-#include <hairvox/volumetric/radiance_basis.h>
+#include <hairvox/core/vecmath.h>
 
-#include <span>
 #include <vector>
 
 namespace hairvox {
 
 class MarschnerBcsdf;
 
-/// Which of Marschner's lobes a kernel holds.
-enum class KernelLobes {
-    All,
-    Forward,  ///< TT
-    Backward, ///< R and TRT
-};
-
 class ScatteringKernel {
 public:
-    ScatteringKernel(const MarschnerBcsdf& bcsdf, const RadianceBasis& basis,
-                     KernelLobes lobes = KernelLobes::All);
+    /// The kernel of `bcsdf` for radiance held to SH order `order` ([1, 8]).
+    ScatteringKernel(const MarschnerBcsdf& bcsdf, int order);
 
-    const RadianceBasis& basis() const { return basis_; }
-    /// Ĝ_ik at the centre of outgoing bin j.
-    const Rgb& at(int j, int i, int k) const {
-        return g_[(std::size_t(j) * std::size_t(basis_.thetaBins) + std::size_t(i)) *
-                      std::size_t(basis_.azimuthalOrder + 1) +
-                  std::size_t(k)];
-    }
-    /// The outgoing table of an incident radiance: both are planar
-    /// [channel][bin][coefficient] arrays of 3·basis().coefficients() floats;
-    /// out[c][j][m] = Σ_i Ĝ_{i,k(m)}(θ_o,j)[c] · in[c][i][m].
-    void apply(std::span<const float> incident, std::span<float> outgoing) const;
+    int order() const { return order_; }
+    /// Outgoing inclinations tabulated (rows, s_o from −1 to 1).
+    static constexpr int kRows = 48;
+
+    /// L_o toward unit ω_o of a fiber of unit tangent u from the incident
+    /// radiance whose SH coefficients are `coefficients` (planar [channel][lm],
+    /// 3·(L + 1)² floats).
+    Rgb apply(const float* coefficients, const Vec3f& u, const Vec3f& omega_o) const;
+
+    /// K's SH coefficients in the fiber's frame at φ_o = 0 (k'_lm = G_lm(s_o)
+    /// for m ≥ 0, 0 for m < 0) into `k` (planar [channel][lm], 3·(L + 1)²
+    /// floats), read between the rows as apply() reads them.
+    void fiberFrameCoefficients(float s_o, float* k) const;
 
 private:
-    RadianceBasis basis_;
-    std::vector<Rgb> g_; ///< [j][i][k]
-    /// apply()'s form of g_: [channel][j][i][m], Ĝ_{i,k(m)}(θ_o,j) repeated
-    /// for a_k and b_k, so that a row of coefficients is one contiguous
-    /// multiply-add.
-    std::vector<float> expanded_;
+    /// The two rows around s_o and the weight of the second.
+    void rows(float s_o, const float*& g0, const float*& g1, float& t) const;
+    /// Values a row holds per channel: G_lm for l ≤ L, 0 ≤ m ≤ l, at l(l + 1)/2 + m.
+    int perChannel() const { return (order_ + 1) * (order_ + 2) / 2; }
+
+    int order_;
+    std::vector<float> g_; ///< [row][channel][l(l + 1)/2 + m]: G_lm(s_o of the row)
 };
 
 } // namespace hairvox
