@@ -1,5 +1,3 @@
-#include "half_convert.h"
-
 #include <hairvox/core/atomic_file.h>
 #include <hairvox/core/error.h>
 #include <hairvox/core/interrupt.h>
@@ -7,7 +5,8 @@
 #include <hairvox/film/exr_codec.h>
 #include <hairvox/film/image_file.h>
 
-#include <openexr.h>
+#include "half_convert.h"
+
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_pipeline.h>
 
@@ -16,18 +15,21 @@
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 #include <ImfStringAttribute.h>
+#include <openexr.h>
+#include <zlib.h>
+
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <bit>
 #include <cstring>
 #include <exception>
-#include <fcntl.h>
 #include <new>
 #include <span>
 #include <stdexcept>
 #include <string>
-#include <unistd.h>
 #include <vector>
-#include <zlib.h>
 
 namespace hairvox {
 
@@ -208,14 +210,10 @@ private:
 
 exr_compression_t coreCompression(ExrCompression c) {
     switch (c) {
-    case ExrCompression::Zips:
-        return EXR_COMPRESSION_ZIPS;
-    case ExrCompression::Zip:
-        return EXR_COMPRESSION_ZIP;
-    case ExrCompression::Rle:
-        return EXR_COMPRESSION_RLE;
-    case ExrCompression::None:
-        return EXR_COMPRESSION_NONE;
+    case ExrCompression::Zips: return EXR_COMPRESSION_ZIPS;
+    case ExrCompression::Zip: return EXR_COMPRESSION_ZIP;
+    case ExrCompression::Rle: return EXR_COMPRESSION_RLE;
+    case ExrCompression::None: return EXR_COMPRESSION_NONE;
     }
     throw std::logic_error("coreCompression");
 }
@@ -246,9 +244,9 @@ public:
 
     void check(exr_result_t result) const {
         if (result != EXR_ERR_SUCCESS)
-            throw InputError(
-                strCat(path_.string(), ": cannot write OpenEXR file: ",
-                       message_.empty() ? exr_get_default_error_message(result) : message_));
+            throw InputError(strCat(path_.string(), ": cannot write OpenEXR file: ",
+                                    message_.empty() ? exr_get_default_error_message(result)
+                                                     : message_));
     }
 
     /// Writes the chunk offsets and closes the file.
@@ -317,9 +315,7 @@ void writeExr(const std::filesystem::path& path, const Film& film, const ExrHead
         file.check(exr_add_part(ctx, nullptr, EXR_STORAGE_SCANLINE, &part));
         file.check(exr_initialize_required_attr_simple(ctx, part, film.width(), film.height(),
                                                        coreCompression(info.compression)));
-        const auto isLong = [](const std::string& n) {
-            return n.size() > kShortNameLength;
-        };
+        const auto isLong = [](const std::string& n) { return n.size() > kShortNameLength; };
         const bool longNames =
             std::any_of(info.attributes.begin(), info.attributes.end(),
                         [&](const auto& attribute) { return isLong(attribute.first); }) ||
@@ -440,10 +436,6 @@ bool chunksInFile(const std::filesystem::path& path) {
     exr_finish(&ctx);
     return inside;
 }
-
-} // namespace
-
-namespace {
 
 /// An EXR file's bytes in memory as OpenEXR's input stream (ImfIO.h): reads
 /// past the end throw, as a file's would.

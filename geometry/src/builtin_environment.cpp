@@ -39,10 +39,16 @@ std::span<const BuiltinEnvironment> builtinEnvironments() {
     return table();
 }
 
-const BuiltinEnvironment& builtinEnvironment(std::string_view name) {
+const BuiltinEnvironment* findBuiltinEnvironment(std::string_view name) {
     for (const BuiltinEnvironment& map : table())
         if (map.name == name)
-            return map;
+            return &map;
+    return nullptr;
+}
+
+const BuiltinEnvironment& builtinEnvironment(std::string_view name) {
+    if (const BuiltinEnvironment* map = findBuiltinEnvironment(name))
+        return *map;
     throw InputError(strCat("no built-in environment map \"", name, "\": expected one of ",
                             builtinEnvironmentNames()));
 }

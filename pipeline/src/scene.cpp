@@ -268,11 +268,8 @@ EnvironmentLight parseEnvironment(JsonObject obj, const std::filesystem::path& b
         env.builtin = v.string();
         if (!env.file.empty())
             v.failExpected("either \"file\" or \"builtin\", not both");
-        try {
-            builtinEnvironment(env.builtin);
-        } catch (const InputError&) {
+        if (!findBuiltinEnvironment(env.builtin))
             v.failExpected(strCat("one of ", builtinEnvironmentNames()));
-        }
     }
     if (const JsonValue v = obj["color"]; v.present())
         env.color = v.rgb(kLightColor);

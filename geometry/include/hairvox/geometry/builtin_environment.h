@@ -26,6 +26,8 @@ struct BuiltinEnvironment {
 /// Every built-in map, in a fixed order.
 std::span<const BuiltinEnvironment> builtinEnvironments();
 
+/// The built-in map of that name, or nullptr.
+const BuiltinEnvironment* findBuiltinEnvironment(std::string_view name);
 /// The built-in map of that name; InputError listing the names if there is none.
 const BuiltinEnvironment& builtinEnvironment(std::string_view name);
 
