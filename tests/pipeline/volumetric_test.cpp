@@ -189,5 +189,86 @@ TEST(VolumetricSlow, HairRadianceMatchesThePathTracerOnBlockMeans) {
     EXPECT_LT(e.relL1, 0.5 * d.relL1);
 }
 
+// The curly close-up (data/scenes/curly_closeup.json), blond: a helix puts
+// fibers of every azimuth in a cell — the scene that measured the reading in
+// each fiber's own frame and the flights leaving their own fiber
+// (docs/DESIGN.md §9); at 80×60.
+TEST(VolumetricSlow, CurlyHairMatchesThePathTracerOnBlockMeans) {
+    test::TempDir dir;
+    Scene scene = loadScene(test::dataDir() / "scenes" / "curly_closeup.json");
+    scene.output = {};
+    scene.fiber.sigma_a = FiberParams::sigmaFromMelanin(0.3f, 0.0f);
+    scene.camera.width = 80;
+    scene.camera.height = 60;
+    scene.globalTermMode = GlobalTermMode::Grid;
+    scene.integrator = Integrator::Volumetric;
+    const Film volumetric = render(scene, dir).film;
+    scene.integrator = Integrator::DualScattering;
+    const Film ds = render(scene, dir).film;
+    scene.integrator = Integrator::Path;
+    scene.pathTrace.spp = 256;
+    const Film pt = render(scene, dir).film;
+    constexpr int kBlock = 4;
+    const ComparedImage reference = hairRadianceOf(pt).boxFiltered(kBlock);
+    const ImageError e = *compareImages(hairRadianceOf(volumetric).boxFiltered(kBlock), reference);
+    const ImageError d = *compareImages(hairRadianceOf(ds).boxFiltered(kBlock), reference);
+    std::cout << "curly, against the path tracer (80x60, 4x4 blocks, its noise " << e.noiseFloorL1
+              << "): volumetric rel L1 " << e.relL1 << ", bias " << e.relBias
+              << "; dual scattering " << d.relL1 << ", bias " << d.relBias << "\n";
+    // Measured: volumetric 0.083 against a floor of 0.057, bias −0.5% (+3–4%
+    // before the flights left their own fiber); dual scattering 0.175.
+    EXPECT_LT(std::abs(e.relBias), 0.025);
+    EXPECT_LT(e.relL1, 0.1);
+    EXPECT_LT(e.relL1, 0.6 * d.relL1);
+}
+
+// Thin hair: depth 2 — light scattered once by one fiber and once more by
+// the fiber seen — against the path tracer capped at the same depth, on the
+// thinned default groom; and multiple scattering vanishing with the density
+// (depth 2 grows as the square of the optical depth, single scattering as it).
+TEST(VolumetricSlow, DepthTwoMatchesThePathTracersOnThinHair) {
+    test::TempDir dir;
+    Scene scene = smallVolumetric(1500, 64);
+    scene.volumetric.maxDepth = 2;
+    const SceneRender volumetric = render(scene, dir);
+    scene.integrator = Integrator::Path;
+    scene.pathTrace.spp = 256;
+    scene.pathTrace.maxDepth = 2;
+    const Film pt = render(scene, dir).film;
+    constexpr int kBlock = 4;
+    const auto multiple = [&](const Film& film) {
+        return ComparedImage::fromFilm(film, {"multiple"}, "hair.A").boxFiltered(kBlock);
+    };
+    const ImageError e = *compareImages(multiple(volumetric.film), multiple(pt));
+    std::cout << "depth 2 against the path tracer's (64², 4x4 blocks): rel L1 " << e.relL1
+              << ", bias " << e.relBias << "\n";
+    // Measured: rel L1 0.135 (the path tracer's noise in it), bias −6.5% —
+    // the deficit at depth 2 that docs/DESIGN.md §9 measures on the default
+    // look (it grows with the voxel: −3.4% at 2.2 mm, −1.5% at 1.1 mm before
+    // the own fiber was taken out of the flights; −5.6% / −5.0% after).
+    EXPECT_LT(std::abs(e.relBias), 0.09);
+    EXPECT_LT(e.relL1, 0.2);
+
+    const auto multipleOverDirect = [&](float k) {
+        Scene thin = smallVolumetric(1500, 64);
+        thin.volumetric.maxDepth = 2;
+        thin.volumetric.paths = 200000;
+        thin.fiberScale.densityMultiplier = k;
+        for (MeshSource& mesh : thin.meshes)
+            mesh.albedo = Rgb(0.0f); // light the skin sends does not thin out with the hair
+        const Film film = render(thin, dir).film;
+        double direct = 0;
+        for (const char* name : {"direct_R", "direct_TT", "direct_TRT"})
+            direct += layerSum(film, name);
+        return layerSum(film, "multiple") / direct;
+    };
+    const float k = scene.fiberScale.densityMultiplier;
+    const double dense = multipleOverDirect(k), thin = multipleOverDirect(k / 8);
+    std::cout << "multiple / direct at k = " << k << ": " << dense << ", at k/8: " << thin << "\n";
+    // Measured: 0.30 and 0.060 (linear in k would be 0.037).
+    EXPECT_GT(dense, 0.0);
+    EXPECT_LT(thin, 0.3 * dense);
+}
+
 } // namespace
 } // namespace hairvox

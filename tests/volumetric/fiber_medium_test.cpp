@@ -162,6 +162,69 @@ TEST(FiberMedium, WalkingVoxelsIntegratesTheDensityAlongALine) {
     }
 }
 
+/// One straight strand of `points` points through the origin along unit u, 1 mm apart.
+Groom straightStrand(const Vec3f& u, int points = 81) {
+    Groom g;
+    std::vector<Vec3f> line;
+    for (int i = 0; i < points; ++i)
+        line.push_back((float(i) - 0.5f * float(points - 1)) * 0.001f * u +
+                       Vec3f(0.0003f, -0.0007f, 0.0011f));
+    g.addStrand(line);
+    return g;
+}
+
+// ownDensity() is the voxelizer's own splat of the fiber: every voxel near
+// the middle of a long straight strand holds what the closed form says.
+TEST(FiberMedium, OwnDensityIsTheSplatOfTheFiber) {
+    const double h = 0.002;
+    for (const Vec3f u : {Vec3f(1, 0, 0), glm::normalize(Vec3f(1, 2, 0.5f)),
+                          glm::normalize(Vec3f(-0.3f, 0.2f, 1))}) {
+        SplatOptions options;
+        options.voxelSize = h;
+        const FiberGrid grid = splatStrands(straightStrand(u), options);
+        const FiberMedium medium(grid);
+        const OwnFiber own{Vec3f(0.0003f, -0.0007f, 0.0011f), u};
+        int checked = 0;
+        for (int x = -3; x <= 3; ++x)
+            for (int y = -3; y <= 3; ++y)
+                for (int z = -3; z <= 3; ++z) {
+                    const glm::ivec3 v(x, y, z);
+                    const std::size_t i = grid.find(openvdb::Coord(x, y, z));
+                    const float splat = i == FiberGrid::kInactive ? 0.0f : grid.density[i];
+                    const float closed = medium.ownDensity(own, v);
+                    EXPECT_NEAR(closed, splat, 2e-3f / float(h * h)) << "voxel " << v << " u " << u;
+                    if (!medium.nearOwnFiber(own, v)) {
+                        EXPECT_EQ(closed, 0.0f) << "voxel " << v;
+                    }
+                    checked += splat > 0;
+                }
+        EXPECT_GT(checked, 8) << u;
+    }
+}
+
+// A flight leaving a lone fiber never meets it again; without the
+// exclusion it would, about 1 − e^{−n_own} of the time.
+TEST(FiberMedium, AFlightDoesNotMeetTheFiberItLeaves) {
+    const Vec3f u = glm::normalize(Vec3f(1, 0.3f, 0.2f));
+    SplatOptions options;
+    options.voxelSize = 0.0005;
+    options.fiberScale.diameter = 0.0002f;
+    options.fiberScale.densityMultiplier = 4;
+    const FiberGrid grid = splatStrands(straightStrand(u), options);
+    const FiberMedium medium(grid);
+    Pcg32 rng(11);
+    int withOwn = 0, without = 0;
+    const int n = 4000;
+    for (int i = 0; i < n; ++i) {
+        const OwnFiber own{Vec3f(0.0003f, -0.0007f, 0.0011f) + rng.uniform(-0.01f, 0.01f) * u, u};
+        const Vec3f dir = uniformSphere(rng.uniformFloat(), rng.uniformFloat());
+        withOwn += medium.sampleCollision(own.position, dir, 1.0f, rng, &own).has_value();
+        without += medium.sampleCollision(own.position, dir, 1.0f, rng).has_value();
+    }
+    EXPECT_LT(withOwn, n / 200) << "met " << withOwn << " of " << n;
+    EXPECT_GT(without, n / 20) << "met " << without << " of " << n;
+}
+
 TEST(FiberMedium, EmptyGridHasNoCollisions) {
     FiberGrid grid;
     grid.info.voxelSize = 0.01;

@@ -155,8 +155,73 @@ void FiberMedium::sampleFiber(std::size_t v, const Vec3f& omega, Pcg32& rng,
     }
 }
 
+bool FiberMedium::nearOwnFiber(const OwnFiber& own, const glm::ivec3& v) const {
+    // The splat of v reaches the cube |p − v|∞ < 1 (voxels), which lies within √3 of v.
+    const Vec3f a = own.position / h_ - Vec3f(v);
+    const float along = glm::dot(a, own.tangent);
+    return glm::dot(a, a) - along * along < 3.0f;
+}
+
+float FiberMedium::ownFiberReach(const OwnFiber& own, const Vec3f& dir) const {
+    // A voxel whose box holds x(t) lies within √3/2 voxels of it, and the line
+    // must pass within √3 of the voxel: x(t) within (3/2)√3 h of the line,
+    // which it leaves at t·|dir × u|.
+    constexpr float kReach = 1.5f * 1.7320508f;
+    const float away = glm::length(glm::cross(dir, own.tangent));
+    return away * std::numeric_limits<float>::max() > kReach * h_
+               ? kReach * h_ / away
+               : std::numeric_limits<float>::max();
+}
+
+float FiberMedium::ownDensity(const OwnFiber& own, const glm::ivec3& v) const {
+    // p(s) = a + s·b in voxels from v; the tents' product is positive on
+    // (s0, s1) and a cubic between the points where a coordinate crosses 0:
+    // two Gauss–Legendre nodes per piece integrate it exactly.
+    const Vec3f a = own.position / h_ - Vec3f(v);
+    const Vec3f& b = own.tangent;
+    float s0 = -std::numeric_limits<float>::infinity(), s1 = -s0;
+    for (int i = 0; i < 3; ++i) {
+        if (std::abs(b[i]) < 1e-7f) {
+            if (!(std::abs(a[i]) < 1.0f))
+                return 0.0f;
+            continue;
+        }
+        const float lo = (-1.0f - a[i]) / b[i], hi = (1.0f - a[i]) / b[i];
+        s0 = std::max(s0, std::min(lo, hi));
+        s1 = std::min(s1, std::max(lo, hi));
+    }
+    if (!(s0 < s1))
+        return 0.0f;
+    std::array<float, 5> knots{s0, s1, s1, s1, s1};
+    int n = 2;
+    for (int i = 0; i < 3; ++i)
+        if (std::abs(b[i]) >= 1e-7f) {
+            const float z = -a[i] / b[i];
+            if (z > s0 && z < s1)
+                knots[std::size_t(n++)] = z;
+        }
+    std::sort(knots.begin(), knots.begin() + n);
+    const auto tents = [&](float s) {
+        const Vec3f p = a + s * b;
+        return std::max(0.0f, 1.0f - std::abs(p.x)) * std::max(0.0f, 1.0f - std::abs(p.y)) *
+               std::max(0.0f, 1.0f - std::abs(p.z));
+    };
+    constexpr float kNode = 0.57735026919f; // 1/√3
+    float integral = 0;
+    for (int k = 0; k + 1 < n; ++k) {
+        const float mid = 0.5f * (knots[std::size_t(k)] + knots[std::size_t(k + 1)]);
+        const float half = 0.5f * (knots[std::size_t(k + 1)] - knots[std::size_t(k)]);
+        integral += half * (tents(mid - kNode * half) + tents(mid + kNode * half));
+    }
+    return integral / (h_ * h_);
+}
+
 std::optional<MediumCollision> FiberMedium::sampleCollision(const Vec3f& origin, const Vec3f& dir,
-                                                            float tMax, Pcg32& rng) const {
+                                                            float tMax, Pcg32& rng,
+                                                            const OwnFiber* own) const {
+    // The own fiber's cross-section toward dir: k·D·|dir × u| per unit λ_own.
+    const float ownCross = own ? kD_ * glm::length(glm::cross(dir, own->tangent)) : 0.0f;
+    const float ownReach = own ? ownFiberReach(*own, dir) : 0.0f;
     std::optional<MediumCollision> hit;
     walkBlocks(origin, dir, tMax, [&](std::int32_t block, float tEnter, float tExit) {
         const float majorant = majorant_[std::size_t(block)];
@@ -167,11 +232,17 @@ std::optional<MediumCollision> FiberMedium::sampleCollision(const Vec3f& origin,
             if (!(t < tExit))
                 return true;
             const Vec3f x = origin + t * dir;
-            const std::int64_t v = voxelAt(x / h_ + 0.5f);
+            const Vec3f q = x / h_ + 0.5f;
+            const std::int64_t v = voxelAt(q);
             if (v < 0)
                 continue;
-            const float sigma =
+            float sigma =
                 kD_ * grid_->density[std::size_t(v)] * meanCosTheta(std::size_t(v), dir);
+            if (ownCross > 0 && t < ownReach) {
+                const glm::ivec3 ijk(floorToInt(q.x), floorToInt(q.y), floorToInt(q.z));
+                if (nearOwnFiber(*own, ijk))
+                    sigma -= ownCross * ownDensity(*own, ijk);
+            }
             if (rng.uniformFloat() * majorant < sigma) {
                 MediumCollision c;
                 c.t = t;

@@ -140,6 +140,7 @@ private:
         const SurfaceScene* surfaces =
             scene_.surfaces && !scene_.surfaces->empty() ? scene_.surfaces.get() : nullptr;
         std::optional<RayOrigin> from; // the fiber a ray leaves (fiber transport)
+        std::optional<OwnFiber> own;   // the fiber a flight leaves, as the medium holds it
         for (;;) {
             std::optional<SurfaceHit> surface;
             std::optional<MediumCollision> hit;
@@ -165,14 +166,15 @@ private:
                     surface = surfaces->intersect(ray.origin, ray.dir,
                                                   std::numeric_limits<float>::infinity());
                 tSurface = surface ? surface->t : std::numeric_limits<float>::infinity();
-                hit = medium_.sampleCollision(ray.origin, ray.dir, tSurface, rng);
+                hit = medium_.sampleCollision(ray.origin, ray.dir, tSurface, rng,
+                                              own ? &*own : nullptr);
                 if (hit)
                     surface.reset();
             }
             if (surface)
                 from.reset();
             if (scattered)
-                deposit(ray, hit ? hit->t : tSurface, power, record);
+                deposit(ray, hit ? hit->t : tSurface, power, own ? &*own : nullptr, record);
             if (surface && scattered && surfaceCells_) {
                 const Vec3f x = ray.origin + surface->t * ray.dir;
                 if (const std::int64_t slot = surfaceCells_->slotAt(x); slot >= 0)
@@ -187,6 +189,7 @@ private:
                 ray.dir = cosineHemisphere(surface->normal, rng.uniformFloat(), rng.uniformFloat());
                 if (!(glm::dot(ray.dir, ng) > 0))
                     break; // below the surface: the shading normal's lobe dips under it
+                own.reset();
             } else if (hit) {
                 ++c.fiberEvents;
                 const MarschnerBcsdf& bcsdf = bcsdfs_[hit->fiberType];
@@ -199,6 +202,7 @@ private:
                 power *= s.weight;
                 ray.origin = hit->position;
                 ray.dir = s.wi;
+                own = OwnFiber{hit->position, hit->tangent};
             } else {
                 break; // left the hair
             }
@@ -221,8 +225,10 @@ private:
     }
 
     /// The flight origin + t·dir, t ∈ [0, tEnd], into the cells it crosses:
-    /// ∫ λ dt over each run of its voxels in one cell.
-    void deposit(const Ray& ray, float tEnd, const Rgb& power, ChunkRecord& record) const {
+    /// ∫ λ dt over each run of its voxels in one cell, without the share of
+    /// `own`, the fiber it leaves (null: none; fiber_medium.h).
+    void deposit(const Ray& ray, float tEnd, const Rgb& power, const OwnFiber* own,
+                 ChunkRecord& record) const {
         const auto flight = static_cast<std::uint32_t>(record.flights.size());
         const std::size_t first = record.crossings.size();
         std::int64_t slot = -1;
@@ -232,6 +238,7 @@ private:
                 record.crossings.push_back({std::uint32_t(slot), flight, sum});
         };
         const FiberGrid& grid = medium_.grid();
+        const float ownReach = own ? medium_.ownFiberReach(*own, ray.dir) : 0.0f;
         medium_.walkVoxels(ray.origin, ray.dir, tEnd,
                            [&](std::size_t v, const glm::ivec3& ijk, float t0, float t1) {
                                const std::int64_t s = cache_.slotOfVoxel(ijk);
@@ -240,7 +247,10 @@ private:
                                    slot = s;
                                    sum = 0;
                                }
-                               sum += grid.density[v] * (t1 - t0);
+                               float lambda = grid.density[v];
+                               if (t0 < ownReach && medium_.nearOwnFiber(*own, ijk))
+                                   lambda = std::max(0.0f, lambda - medium_.ownDensity(*own, ijk));
+                               sum += lambda * (t1 - t0);
                            });
         flush();
         if (record.crossings.size() > first)

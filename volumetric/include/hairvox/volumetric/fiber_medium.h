@@ -30,6 +30,18 @@
 // probability c·cos θ(ω, o/c)/E[cos θ]; otherwise a fiber of uniformly random
 // direction weighted by its cos θ (rejection from the sphere, acceptance π/4).
 // Its type is drawn by the voxel's type fractions f_t (fiber_grid.h).
+//
+// The fiber a flight leaves. A flight that starts on a fiber (a scattering)
+// does not meet that fiber again — the path tracer's ribbons skip their own
+// (geometry/ray_scene.h) — but the voxels around it hold its splat. Its
+// share of voxel v, the splat of the straight line x + s·u,
+//     λ_own,v = (1/h²)·∫ Π_i (1 − |x_i/h − v_i + s·u_i|)⁺ ds
+// (s in voxels; the adjoint of trilinear interpolation, as the voxelizer
+// splats; ownDensity() integrates the piecewise cubic exactly), is taken out
+// of σ_t along the flight, σ_t − k·D·λ_own,v·|ω × u| (clamped at 0), and
+// out of its deposits. The fiber grid's own-fiber correction of the shadow
+// rays (transmittance/grid_global_term.h) is the same splat, integrated
+// along a ray in closed form under its Gaussian blur.
 #pragma once
 
 #include <hairvox/core/grid_traversal.h>
@@ -55,6 +67,13 @@ struct MediumCollision {
     std::uint8_t fiberType = 0;
 };
 
+/// The fiber a flight leaves (see above): a straight line through
+/// `position` along unit `tangent`.
+struct OwnFiber {
+    Vec3f position{0.0f};
+    Vec3f tangent{0.0f, 1.0f, 0.0f};
+};
+
 class FiberMedium {
 public:
     /// The medium of `grid` (whose fiber scale gives k and D). Keeps a
@@ -66,10 +85,22 @@ public:
     float extinction(const Vec3f& x, const Vec3f& omega) const;
 
     /// The next fiber a ray from `origin` along unit `dir` meets before
-    /// `tMax`, or nothing (the ray leaves the hair, or reaches tMax first).
-    /// Draws from `rng` (delta tracking and the fiber's orientation and type).
-    std::optional<MediumCollision> sampleCollision(const Vec3f& origin, const Vec3f& dir, float tMax,
-                                                   Pcg32& rng) const;
+    /// `tMax`, or nothing (the ray leaves the hair, or reaches tMax first);
+    /// never `own`, the fiber the ray leaves (null: none). Draws from `rng`
+    /// (delta tracking and the fiber's orientation and type).
+    std::optional<MediumCollision> sampleCollision(const Vec3f& origin, const Vec3f& dir,
+                                                   float tMax, Pcg32& rng,
+                                                   const OwnFiber* own = nullptr) const;
+
+    /// λ_own,v (fiber length per volume): the share of voxel v (index space)
+    /// that the splat of the straight fiber `own` holds (see above).
+    float ownDensity(const OwnFiber& own, const glm::ivec3& v) const;
+    /// Whether voxel v can hold a share of `own` (a cheap bound before
+    /// ownDensity): the line passes within its splat's reach of v.
+    bool nearOwnFiber(const OwnFiber& own, const glm::ivec3& v) const;
+    /// How far a ray from own.position along unit `dir` can meet a voxel that
+    /// holds a share of `own`: beyond it no voxel is near the fiber.
+    float ownFiberReach(const OwnFiber& own, const Vec3f& dir) const;
 
     /// Calls visit(value index, voxel, tEnter, tExit) for every active voxel
     /// the segment origin + t·dir, t ∈ [0, tEnd], crosses, in order (unit
