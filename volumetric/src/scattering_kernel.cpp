@@ -54,7 +54,9 @@ ScatteringKernel::ScatteringKernel(const MarschnerBcsdf& bcsdf, int order)
                 const double s = mid + half * panel.node(g);
                 const auto theta_i = float(safeASin(s));
                 const double c = cosFromSin(s), ws = panel.weight(g) * half * dPhi;
-                for (int p = 0; p < kProjectionPhi; ++p) {
+                // f_s is even in φ_i (above) and so are the m ≥ 0 harmonics:
+                // the nodes at φ_i > 0 count twice, and the m < 0 ones (odd) vanish.
+                for (int p = kProjectionPhi / 2; p < kProjectionPhi; ++p) {
                     const double phi_i = -Pi + (p + 0.5) * dPhi;
                     Rgbd f(0.0);
                     for (int tw = 0; tw < twists; ++tw) {
@@ -64,16 +66,19 @@ ScatteringKernel::ScatteringKernel(const MarschnerBcsdf& bcsdf, int order)
                                                                     float(phi_h)))
                                       .sum());
                     }
-                    f = f * (c * ws / twists); // f_s cos θ_i ds dφ
+                    f = f * (2.0 * c * ws / twists); // f_s cos θ_i ds dφ, at ±φ_i
                     SphericalHarmonics::evaluate(
                         local(float(s), float(c), float(std::cos(phi_i)), float(std::sin(phi_i))),
                         order, y.data());
-                    for (int m = 0; m < nc; ++m)
-                        k[std::size_t(m)] += f * double(y[std::size_t(m)]);
+                    for (int l = 0; l <= order; ++l)
+                        for (int m = 0; m <= l; ++m) {
+                            const auto i = std::size_t(SphericalHarmonics::index(l, m));
+                            k[i] += f * double(y[i]);
+                        }
                 }
             }
         }
-        // G_lm = k_lm (m ≥ 0); the sin terms k_l,−m vanish by the evenness in φ.
+        // G_lm = k_lm (m ≥ 0).
         float* row = g_.data() + std::size_t(j) * 3 * std::size_t(ng);
         for (int l = 0; l <= order; ++l)
             for (int m = 0; m <= l; ++m)
