@@ -12,6 +12,16 @@
 
 static constexpr float kInfinity = std::numeric_limits<float>::infinity();
 
+/// The bits set in x: one instruction where the target has POPCNT
+/// (brick_march.cpp), else popcount64's arithmetic.
+static int bitCount(std::uint64_t x) {
+#if HWY_TARGET <= HWY_AVX2
+    return __builtin_popcountll(x);
+#else
+    return popcount64(x);
+#endif
+}
+
 /// Four floats in a SIMD register (GCC's and Clang's vector extension).
 using Half = float __attribute__((vector_size(16)));
 /// A Lanes value in registers as kParts vectors of kPartLanes floats: one
@@ -173,7 +183,7 @@ static CellCorners cornersOf(const BrickVolume& v, std::size_t brick, const glm:
         const int bit = slot & 63;
         const std::uint64_t word = present.bits[w];
         std::size_t rank =
-            present.rank[w] + std::size_t(popcount64(word & ((std::uint64_t(1) << bit) - 1)));
+            present.rank[w] + std::size_t(bitCount(word & ((std::uint64_t(1) << bit) - 1)));
         // (The dz = 1 slot is the next bit, in the next word after bit 63;
         // slots end at 728, so that word exists.)
         const std::uint64_t high = bit < 63 ? word >> (bit + 1) : present.bits[w + 1];
