@@ -70,26 +70,28 @@ std::size_t BrickVolume::memoryBytes() const {
 }
 
 BrickVolume::OctantBoxes BrickVolume::octantBoxes(const std::array<std::uint64_t, 8>& mask) {
-    OctantBoxes result;
-    auto& boxes = result.box;
-    boxes.fill({{8, 8, 8}, {0, 0, 0}});
+    OctantBoxes boxes;
+    for (std::size_t a = 0; a < 3; ++a) {
+        boxes.lo[a].fill(8);
+        boxes.hi[a].fill(0);
+    }
     for (int x = 0; x < 8; ++x)
         for (std::uint64_t word = mask[std::size_t(x)]; word != 0; word &= word - 1) {
             const int bit = std::countr_zero(word);
             const std::array<int, 3> c{x, bit >> 3, bit & 7};
-            auto& box = boxes[std::size_t(((c[0] >> 2) * 2 + (c[1] >> 2)) * 2 + (c[2] >> 2))];
+            const auto o = std::size_t(((c[0] >> 2) * 2 + (c[1] >> 2)) * 2 + (c[2] >> 2));
             for (std::size_t a = 0; a < 3; ++a) {
-                box.lo[a] = std::min(box.lo[a], static_cast<std::uint8_t>(c[a]));
-                box.hi[a] = std::max(box.hi[a], static_cast<std::uint8_t>(c[a]));
+                boxes.lo[a][o] = std::min(boxes.lo[a][o], static_cast<std::uint8_t>(c[a]));
+                boxes.hi[a][o] = std::max(boxes.hi[a][o], static_cast<std::uint8_t>(c[a]));
             }
         }
-    result.whole = true;
+    boxes.whole = true;
     for (std::size_t o = 0; o < 8; ++o)
         for (std::size_t a = 0; a < 3; ++a) {
             const int lo = (o >> (2 - a) & 1) ? 4 : 0; // the octant's own cells
-            result.whole = result.whole && boxes[o].lo[a] == lo && boxes[o].hi[a] == lo + 3;
+            boxes.whole = boxes.whole && boxes.lo[a][o] == lo && boxes.hi[a][o] == lo + 3;
         }
-    return result;
+    return boxes;
 }
 
 std::int64_t BrickVolume::find(const glm::ivec3& b) const {
@@ -257,11 +259,13 @@ Bounds3f BrickVolume::valueBounds(std::size_t brick) const {
     Bounds3f bounds;
     const glm::ivec3 base = kBrick * brickCoord_[brick];
     const float h = static_cast<float>(h_);
-    for (const CellBox& box : cellBoxes_[brick].box) {
-        if (box.lo[0] > box.hi[0])
+    const OctantBoxes& boxes = cellBoxes_[brick];
+    for (std::size_t o = 0; o < 8; ++o) {
+        if (boxes.lo[0][o] > boxes.hi[0][o])
             continue; // an octant without such cells
-        bounds.extend(Vec3f(base + glm::ivec3(box.lo[0], box.lo[1], box.lo[2])) * h);
-        bounds.extend(Vec3f(base + glm::ivec3(box.hi[0], box.hi[1], box.hi[2]) + 1) * h);
+        bounds.extend(Vec3f(base + glm::ivec3(boxes.lo[0][o], boxes.lo[1][o], boxes.lo[2][o])) * h);
+        bounds.extend(Vec3f(base + glm::ivec3(boxes.hi[0][o], boxes.hi[1][o], boxes.hi[2][o]) + 1) *
+                      h);
     }
     return bounds;
 }

@@ -239,12 +239,11 @@ private:
     /// cell holds a value: a line's walk skips the other cells on one test.
     std::vector<std::array<std::uint64_t, 8>> cellMask_;
     /// Per brick and octant of 4³ cells, the box of those cells: local cell
-    /// coordinates lo..hi per axis (lo > hi where the octant has none).
-    struct CellBox {
-        std::array<std::uint8_t, 3> lo, hi;
-    };
+    /// coordinates lo[axis][octant]..hi[axis][octant] (lo > hi where the
+    /// octant has none), an axis's 8 octants side by side for the SIMD
+    /// targets' slab tests (brick_march-inl.h, valueSpan).
     struct OctantBoxes {
-        std::array<CellBox, 8> box;
+        std::array<std::array<std::uint8_t, 8>, 3> lo, hi;
         /// Every box is its whole octant (a dense brick): any line through
         /// the brick meets one, and the test is skipped.
         bool whole = false;
