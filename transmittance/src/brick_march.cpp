@@ -30,9 +30,11 @@
 #include <vector>
 
 HWY_BEFORE_NAMESPACE();
-#if HWY_TARGET <= HWY_AVX2
+#if HWY_TARGET <= HWY_AVX2 && !defined(__clang__)
 // Every CPU with AVX2 has POPCNT, which Highway's target string leaves out:
 // a slot's rank (brick_march-inl.h, cornersOf) is then one instruction.
+// (Clang expands __builtin_popcountll inline without it; GCC would call
+// libgcc.)
 #pragma GCC target("popcnt")
 #endif
 namespace hairvox::detail {
