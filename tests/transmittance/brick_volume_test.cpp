@@ -3,12 +3,15 @@
 // trilinear field: the walk skips empty super-bricks, bricks and the bricks
 // whose values' cells a line misses, and none of that may lose a value.
 #include "../../transmittance/src/brick_volume.h"
+#include "test_util.h"
 
 #include <hairvox/core/rng.h>
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <hwy/targets.h>
 #include <vector>
 
 namespace hairvox::detail {
@@ -26,10 +29,15 @@ struct SparseVolume {
     SparseVolume() {
         Pcg32 rng(5);
         for (int i = 0; i < 300; ++i)
-            voxels.emplace_back(static_cast<int>(rng.nextU32() % 40), static_cast<int>(rng.nextU32() % 40),
+            voxels.emplace_back(static_cast<int>(rng.nextU32() % 40),
+                                static_cast<int>(rng.nextU32() % 40),
                                 static_cast<int>(rng.nextU32() % 40));
-        const auto brickOf = [](const glm::ivec3& c) { return c >> 3; };
-        const auto localOf = [&](const glm::ivec3& c) { return c - 8 * brickOf(c); };
+        const auto brickOf = [](const glm::ivec3& c) {
+            return c >> 3;
+        };
+        const auto localOf = [&](const glm::ivec3& c) {
+            return c - 8 * brickOf(c);
+        };
         for (const glm::ivec3& c : voxels) {
             const glm::ivec3 l = localOf(c);
             volume.reserveBrick(brickOf(c),
@@ -43,7 +51,8 @@ struct SparseVolume {
             OpticalDepths d;
             d.n = rng.uniform(0.5f, 2.0f);
             d.tauP = Rgb(rng.uniform(0.1f, 1.0f), rng.uniform(0.1f, 1.0f), rng.uniform(0.1f, 1.0f));
-            d.sumBeta2 = Rgb(rng.uniform(0.1f, 1.0f), rng.uniform(0.1f, 1.0f), rng.uniform(0.1f, 1.0f));
+            d.sumBeta2 =
+                Rgb(rng.uniform(0.1f, 1.0f), rng.uniform(0.1f, 1.0f), rng.uniform(0.1f, 1.0f));
             volume.set(volume.brickSet(brickOf(c)), localOf(c), d);
         }
     }
@@ -59,7 +68,7 @@ struct SparseVolume {
             const double w = (k == 0 || k == kSteps) ? 1 : (k % 2 ? 4 : 2);
             const OpticalDepths d =
                 volume.sample(origin + static_cast<float>(double(t0) + k * dt) * dir);
-            const float v[7] = {d.n,           d.tauP.r,      d.tauP.g,     d.tauP.b,
+            const float v[7] = {d.n,          d.tauP.r,     d.tauP.g,    d.tauP.b,
                                 d.sumBeta2.r, d.sumBeta2.g, d.sumBeta2.b};
             for (int c = 0; c < 7; ++c)
                 sum[c] += w * double(v[c]);
@@ -72,12 +81,13 @@ struct SparseVolume {
 };
 
 void expectNear(const OpticalDepths& a, const OpticalDepths& ref, const char* what, int line) {
-    const float got[7] = {a.n, a.tauP.r, a.tauP.g, a.tauP.b, a.sumBeta2.r, a.sumBeta2.g, a.sumBeta2.b};
-    const float want[7] = {ref.n,         ref.tauP.r,    ref.tauP.g,   ref.tauP.b,
+    const float got[7] = {a.n,          a.tauP.r,     a.tauP.g,    a.tauP.b,
+                          a.sumBeta2.r, a.sumBeta2.g, a.sumBeta2.b};
+    const float want[7] = {ref.n,          ref.tauP.r,     ref.tauP.g,    ref.tauP.b,
                            ref.sumBeta2.r, ref.sumBeta2.g, ref.sumBeta2.b};
     for (int c = 0; c < 7; ++c)
-        ASSERT_NEAR(got[c], want[c], 1e-3f * want[c] + 1e-4f) << what << ", line " << line
-                                                              << ", channel " << c;
+        ASSERT_NEAR(got[c], want[c], 1e-3f * want[c] + 1e-4f)
+            << what << ", line " << line << ", channel " << c;
 }
 
 /// Lines through the volume: random ones, and ones along the cells' faces and
@@ -150,6 +160,52 @@ TEST(BrickVolume, CumulativeSamplesMatchTheIntegralsUpToThem) {
                        int(i));
         }
     }
+}
+
+TEST(BrickVolume, EverySimdTargetIntegratesToTheSameBits) {
+    // The line integrals are compiled once per SIMD target (brick_march.cpp)
+    // and must not depend on the host's: the same sums in the same order at
+    // every vector width, and no a·b + c contracted into an FMA.
+    const SparseVolume v;
+    const auto lines = testLines(v);
+    std::vector<std::uint32_t> bricks(v.volume.brickCount());
+    for (std::size_t b = 0; b < bricks.size(); ++b)
+        bricks[b] = static_cast<std::uint32_t>(b);
+    const auto integrals = [&] {
+        std::vector<float> out;
+        std::vector<BrickVolume::BrickCrossing> crossings;
+        std::vector<BrickVolume::CumulativeSample> recorded;
+        for (std::size_t i = 0; i < lines.size(); ++i) {
+            const auto& [origin, dir] = lines[i];
+            bool touched = false;
+            const OpticalDepths d =
+                v.volume.integrate(origin, dir, 0.0f, 120.0f, kNeverOpaque, touched);
+            out.insert(out.end(), {d.n, d.tauP.r, d.tauP.g, d.tauP.b, d.sumBeta2.r, d.sumBeta2.g,
+                                   d.sumBeta2.b});
+            v.volume.integrateCumulative(origin, dir, 0.0f, 0.75f, 160, kNeverOpaque, bricks,
+                                         crossings, recorded);
+            for (const auto& sample : recorded)
+                out.insert(out.end(), std::begin(sample.value.v), std::end(sample.value.v));
+            const OpticalDepths s = v.volume.sample(origin + 60.0f * dir);
+            out.insert(out.end(), {s.n, s.tauP.r, s.sumBeta2.b});
+        }
+        return out;
+    };
+    // The baseline (the last target: Highway lists the best first).
+    std::vector<float> reference;
+    std::vector<std::int64_t> targets;
+    for (const std::int64_t target : hwy::SupportedAndGeneratedTargets())
+        targets.push_back(target);
+    ASSERT_GE(targets.size(), 2u) << "one SIMD target only: nothing to compare";
+    hwy::SetSupportedTargetsForTest(targets.back());
+    reference = integrals();
+    hwy::SetSupportedTargetsForTest(0);
+    ASSERT_GT(reference.size(), 3000u);
+    test::forEachSimdTarget([&] {
+        const std::vector<float> got = integrals();
+        ASSERT_EQ(got.size(), reference.size());
+        EXPECT_EQ(std::memcmp(got.data(), reference.data(), got.size() * sizeof(float)), 0);
+    });
 }
 
 } // namespace

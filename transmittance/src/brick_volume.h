@@ -64,14 +64,13 @@ struct alignas(32) Lanes {
     float v[8] = {};
 
     static Lanes from(const OpticalDepths& d) {
-        return {{d.n, d.tauP.r, d.tauP.g, d.tauP.b, d.sumBeta2.r, d.sumBeta2.g, d.sumBeta2.b, 0.0f}};
+        return {
+            {d.n, d.tauP.r, d.tauP.g, d.tauP.b, d.sumBeta2.r, d.sumBeta2.g, d.sumBeta2.b, 0.0f}};
     }
     bool opaque(float depth) const {
         return v[0] > depth && v[1] > depth && v[2] > depth && v[3] > depth;
     }
-    OpticalDepths depths() const {
-        return {v[0], Rgb(v[1], v[2], v[3]), Rgb(v[4], v[5], v[6])};
-    }
+    OpticalDepths depths() const { return {v[0], Rgb(v[1], v[2], v[3]), Rgb(v[4], v[5], v[6])}; }
 };
 
 /// std::popcount inline: x86-64's baseline has no POPCNT instruction, and
@@ -93,15 +92,20 @@ inline int popcount64(std::uint64_t x) {
 /// zero and add nothing to an interpolation).
 struct CellCorners {
     int count = 0;
-    std::array<std::uint8_t, 8> k;          ///< corner dx·4 + dy·2 + dz
+    std::array<std::uint8_t, 8> k; ///< corner dx·4 + dy·2 + dz
     std::array<const Lanes*, 8> value;
 };
 
+/// The line integrals' code for one SIMD target (brick_march-inl.h, compiled
+/// per target by brick_march.cpp).
+template <typename Target>
+struct BrickMarch;
+
 class BrickVolume {
 public:
-    static constexpr int kBrick = 8;                            ///< voxels per brick side
-    static constexpr int kSide = kBrick + 1;                    ///< with the apron
-    static constexpr int kBrickValues = kSide * kSide * kSide;  ///< 729
+    static constexpr int kBrick = 8;                           ///< voxels per brick side
+    static constexpr int kSide = kBrick + 1;                   ///< with the apron
+    static constexpr int kBrickValues = kSide * kSide * kSide; ///< 729
 
     explicit BrickVolume(double voxelSize);
 
@@ -137,7 +141,6 @@ public:
     void allocateValues();
     /// Stores the value of a reserved voxel in its brick and the aprons below.
     void set(const BrickSet& bricks, const glm::ivec3& local, const OpticalDepths& value);
-
 
     /// ∫_{tStart}^{tEnd} of the trilinear field along origin + t·dir (dir unit,
     /// world units), exact. Stops early once n and every channel of tauP
@@ -184,33 +187,10 @@ public:
     Bounds3f bounds() const;
 
 private:
-    /// Calls visit(brickIndex, brickCoord, sEnter, sExit) for the bricks that
-    /// exist along O + s·dir (index space), s ∈ [s0, s1), in order, while it
-    /// returns true.
-    template <typename F>
-    void walkBricks(const Vec3f& O, const Vec3f& dir, float s0, float s1, F&& visit) const;
-    /// Walks the cells of one brick over s ∈ [sa, sb), cut further at
-    /// nextSplit(s) (the next cut after s), calling onPiece(s0, s1, f0, fm, f1)
-    /// with the field at each piece's ends and middle (nothing for cells whose
-    /// corners are all zero).
-    template <typename NextSplit, typename OnPiece>
-    void forEachPiece(std::size_t brick, const glm::ivec3& b, const GridLine<float>& line,
-                      float sa, float sb, NextSplit&& nextSplit, OnPiece&& onPiece) const;
-    /// Where the cell walk of `line` over s ∈ [s0, s1) through brick `brick`
-    /// (at brick coordinate b) may enter a cell a value is a corner of: false
-    /// where it cannot (the line misses the boxes of those cells, widened
-    /// against rounding), else [sa, sb] ⊆ [s0, s1] covering every box it
-    /// meets. Outside [sa, sb] the line crosses only cells without a value,
-    /// whose pieces add nothing, and at sa > s0 it is in such a cell (a
-    /// widened box's face lies a margin outside every box), where the walk
-    /// would have arrived with a zero field too: walking [sa, sb] instead of
-    /// [s0, s1), or skipping the brick, leaves every result as it was. At
-    /// 0.5 mm on Ratboy a line meets ~3 cells with values of the ~10 it
-    /// crosses in a brick.
-    bool valueSpan(std::size_t brick, const glm::ivec3& b, const GridLine<float>& line, float s0,
-                   float s1, float& sa, float& sb) const;
-    /// The corners holding a value of the cell at `cell` ∈ [0, 8)³ of brick `brick`.
-    CellCorners cornersOf(std::size_t brick, const glm::ivec3& cell) const;
+    template <typename Target>
+    friend struct BrickMarch;
+    /// Slot of the voxel at (x, y, z) ∈ [0, kSide)³ of a brick.
+    static int valueIndex(int x, int y, int z) { return (x * kSide + y) * kSide + z; }
     /// Index of the brick at brick coordinate b, or −1.
     std::int64_t find(const glm::ivec3& b) const;
     /// Whether brick b exists, from the occupancy bits (no hashing): what a
@@ -250,21 +230,20 @@ private:
 
     double h_;
     float invH_;
-    std::vector<std::int64_t> slots_;  ///< open addressing: brick index per slot, −1 if free
+    std::vector<std::int64_t> slots_; ///< open addressing: brick index per slot, −1 if free
     std::size_t brickCount_ = 0;
     std::vector<glm::ivec3> brickCoord_; ///< per brick
-    std::vector<SlotBits> present_; ///< per brick
+    std::vector<SlotBits> present_;      ///< per brick
     std::vector<std::size_t> valueBase_; ///< per brick, its first value in values_
     /// Per brick, one bit per cell (x·64 + y·8 + z) set where a corner of the
     /// cell holds a value: a line's walk skips the other cells on one test.
     std::vector<std::array<std::uint64_t, 8>> cellMask_;
     /// Per brick and octant of 4³ cells, the box of those cells: local cell
-    /// coordinates lo..hi per axis (lo > hi where the octant has none).
-    struct CellBox {
-        std::array<std::uint8_t, 3> lo, hi;
-    };
+    /// coordinates lo[axis][octant]..hi[axis][octant] (lo > hi where the
+    /// octant has none), an axis's 8 octants side by side for the SIMD
+    /// targets' slab tests (brick_march-inl.h, valueSpan).
     struct OctantBoxes {
-        std::array<CellBox, 8> box;
+        std::array<std::array<std::uint8_t, 8>, 3> lo, hi;
         /// Every box is its whole octant (a dense brick): any line through
         /// the brick meets one, and the test is skipped.
         bool whole = false;
