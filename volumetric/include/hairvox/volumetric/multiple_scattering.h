@@ -11,7 +11,9 @@
 // hair's scattered light lights the skin through the cache's irradiance).
 // From its first scattering on, every flight of a path deposits into the
 // cells it crosses the λ-weighted track-length estimate of their radiance
-// (Φ·∫λ dt/Λ, at the flight's direction; radiance_cache.h), and where it
+// (Φ·∫λ dt/Λ, at the flight's direction; radiance_cache.h; λ without the
+// share of the fiber the flight leaves, which it neither meets nor lights:
+// fiber_medium.h), and where it
 // meets a surface its power onto the surface (surface_irradiance.h): the
 // caches hold light that has scattered at least once, so the fragments'
 // single scattering — f_s·V per light with the global term's V — and the
