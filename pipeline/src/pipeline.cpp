@@ -4,6 +4,7 @@
 #include "scene_assets.h"
 #include "surfaces.h"
 
+#include <hairvox/core/disk_cache.h>
 #include <hairvox/core/error.h>
 #include <hairvox/core/format.h>
 #include <hairvox/core/hash.h>
@@ -233,6 +234,8 @@ solveMultiple(const Scene& scene, const PipelineOptions& options, const SceneAss
     vs.lights.insert(vs.lights.end(), environmentLights.begin(), environmentLights.end());
     vs.surfaces = assets.surfaces.scene;
     vs.surfaceAlbedo = assets.surfaces.albedo;
+    const DiskCache kernelCache(detail::tableCacheDirOf(options));
+    vs.kernelCache = &kernelCache;
     VolumetricSettings settings = scene.volumetric;
     settings.threads = options.threads;
     settings.progress = options.progress;

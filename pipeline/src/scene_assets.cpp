@@ -172,6 +172,12 @@ SplatOptions splatOptions(const Scene& scene, const PipelineOptions& options) {
 
 namespace detail {
 
+std::filesystem::path tableCacheDirOf(const PipelineOptions& options) {
+    if (!options.tableCacheDir.empty())
+        return options.tableCacheDir;
+    return options.diskCache ? options.diskCache->directory() : defaultTableCacheDir();
+}
+
 FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, SceneAssets* assets,
                           FrameReuse::State* reuse) {
     FrameAssets out;
@@ -223,10 +229,7 @@ FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, Sc
     start = Clock::now();
     TableBuildOptions tableOptions;
     tableOptions.d_b = scene.dualScattering.d_b;
-    // The tables' own disk cache: given, or beside the shared grids and lights.
-    std::filesystem::path tableCacheDir = options.tableCacheDir;
-    if (tableCacheDir.empty())
-        tableCacheDir = disk ? disk->directory() : defaultTableCacheDir();
+    const std::filesystem::path tableCacheDir = tableCacheDirOf(options);
     CrossingTables crossings;
     for (const FiberParams& fiber : assets->groom.palette.fibers) {
         assets->tables.push_back(

@@ -25,6 +25,12 @@ struct FrameAssets {
 /// refers to their grid and groom), taking from `reuse` (when given) the
 /// grid, or every asset of the frame before, where their keys match, and
 /// dropping the rest of the frame before before allocating anew.
+/// Where the tables derived from the fibers' optics (dual-scattering
+/// tables, the volumetric integrator's scattering kernels) are kept between
+/// processes: PipelineOptions::tableCacheDir, or beside the shared grids and
+/// lights of PipelineOptions::diskCache, or defaultTableCacheDir().
+std::filesystem::path tableCacheDirOf(const PipelineOptions& options);
+
 FrameAssets prepareAssets(const Scene& scene, const PipelineOptions& options, SceneAssets* assets,
                           FrameReuse::State* reuse);
 

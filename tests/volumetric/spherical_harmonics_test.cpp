@@ -1,3 +1,6 @@
+#include "../test_util.h"
+
+#include <hairvox/core/disk_cache.h>
 #include <hairvox/core/error.h>
 #include <hairvox/core/gauss_legendre.h>
 #include <hairvox/core/math.h>
@@ -14,6 +17,7 @@
 
 #include <array>
 #include <cmath>
+#include <filesystem>
 #include <functional>
 #include <vector>
 
@@ -189,6 +193,53 @@ TEST(ScatteringKernel, TheRotatedCoefficientsGiveTheNodeEvaluation) {
                     << w_o;
         }
     }
+}
+
+// A kernel taken from the disk cache is the kernel built, float for float;
+// a damaged entry is rebuilt and written again; other optics, another entry.
+TEST(ScatteringKernel, TheDiskCacheGivesTheBuiltKernelAndRebuildsADamagedOne) {
+    namespace fs = std::filesystem;
+    test::TempDir dir;
+    const DiskCache cache(dir / "cache");
+    FiberParams params;
+    params.sigma_a = FiberParams::sigmaFromMelanin(0.3f, 0.1f);
+    constexpr int L = 3;
+    const int nc = SphericalHarmonics::coefficients(L);
+    const auto same = [&](const ScatteringKernel& a, const ScatteringKernel& b) {
+        std::vector<float> ka(3 * std::size_t(nc)), kb(3 * std::size_t(nc));
+        for (const float s_o : {-0.93f, -0.2f, 0.0f, 0.41f, 1.0f}) {
+            a.fiberFrameCoefficients(s_o, ka.data());
+            b.fiberFrameCoefficients(s_o, kb.data());
+            if (ka != kb)
+                return false;
+        }
+        return true;
+    };
+    const ScatteringKernel built(MarschnerBcsdf(params), L);
+    const ScatteringKernel first = ScatteringKernel::loadOrBuild(params, L, &cache);
+    const auto entries = [&] {
+        std::vector<fs::path> files;
+        if (fs::exists(dir / "cache" / "kernel"))
+            for (const auto& e : fs::directory_iterator(dir / "cache" / "kernel"))
+                files.push_back(e.path());
+        return files;
+    };
+    ASSERT_EQ(entries().size(), 1u);
+    const fs::path entry = entries()[0];
+    const auto size = fs::file_size(entry);
+    EXPECT_TRUE(same(first, built));
+    EXPECT_TRUE(same(ScatteringKernel::loadOrBuild(params, L, &cache), built));
+
+    fs::resize_file(entry, size / 2); // a write cut short
+    EXPECT_TRUE(same(ScatteringKernel::loadOrBuild(params, L, &cache), built));
+    EXPECT_EQ(fs::file_size(entry), size);
+
+    FiberParams darker = params;
+    darker.sigma_a = FiberParams::sigmaFromMelanin(1.3f, 0.1f);
+    const ScatteringKernel other = ScatteringKernel::loadOrBuild(darker, L, &cache);
+    EXPECT_EQ(entries().size(), 2u);
+    EXPECT_FALSE(same(other, built));
+    EXPECT_TRUE(same(other, ScatteringKernel(MarschnerBcsdf(darker), L)));
 }
 
 TEST(ScatteringKernel, RotatingTheFiberTheFieldAndTheViewTogetherChangesNothing) {

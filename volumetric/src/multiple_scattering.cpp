@@ -420,7 +420,8 @@ MultipleScatteringSolution solveMultipleScattering(const VolumetricScene& scene,
     const auto finishStart = Clock::now();
     std::vector<ScatteringKernel> kernels;
     for (const FiberParams& fiber : scene.fibers)
-        kernels.emplace_back(MarschnerBcsdf(fiber), settings.cache.shOrder);
+        kernels.push_back(
+            ScatteringKernel::loadOrBuild(fiber, settings.cache.shOrder, scene.kernelCache));
     cache.finish(std::move(kernels));
     stats.finishSeconds = secondsSince(finishStart);
     stats.bytes = cache.memoryBytes() + (out.surfaces ? out.surfaces->memoryBytes() : 0);

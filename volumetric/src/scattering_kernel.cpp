@@ -1,5 +1,7 @@
+#include <hairvox/core/disk_cache.h>
 #include <hairvox/core/error.h>
 #include <hairvox/core/gauss_legendre.h>
+#include <hairvox/core/hash.h>
 #include <hairvox/core/math.h>
 #include <hairvox/shading/marschner.h>
 #include <hairvox/volumetric/scattering_kernel.h>
@@ -11,6 +13,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
+#include <optional>
+#include <span>
+#include <string_view>
 
 namespace hairvox {
 
@@ -86,6 +92,31 @@ ScatteringKernel::ScatteringKernel(const MarschnerBcsdf& bcsdf, int order)
                     row[ch * ng + l * (l + 1) / 2 + m] =
                         float(k[std::size_t(SphericalHarmonics::index(l, m))][ch]);
     });
+}
+
+ScatteringKernel ScatteringKernel::loadOrBuild(const FiberParams& fiber, int order,
+                                               const DiskCache* cache) {
+    if (!cache || order < 1 || order > SphericalHarmonics::kMaxOrder)
+        return ScatteringKernel(MarschnerBcsdf(fiber), order); // (which names a bad order)
+    constexpr std::string_view kKind = "kernel";
+    constexpr std::uint32_t kFormat = 1; // the layout of g_ and the projection's code
+    Hasher h;
+    fiber.hashInto(h);
+    h.value(kFormat).value(order).value(kRows).value(kPanels).value(kPanelPoints);
+    h.value(kProjectionPhi).value(kTwistPoints);
+    const std::uint64_t key = h.digest();
+    const std::size_t floats = std::size_t(kRows) * 3 * std::size_t((order + 1) * (order + 2) / 2);
+    if (const std::optional<std::vector<std::byte>> bytes = cache->load(kKind, key)) {
+        if (bytes->size() == floats * sizeof(float)) {
+            std::vector<float> g(floats);
+            std::memcpy(g.data(), bytes->data(), bytes->size());
+            return ScatteringKernel(order, std::move(g));
+        }
+        cache->discard(kKind, key); // intact, but not a kernel of this layout
+    }
+    ScatteringKernel built(MarschnerBcsdf(fiber), order);
+    cache->store(kKind, key, std::as_bytes(std::span<const float>(built.g_)));
+    return built;
 }
 
 void ScatteringKernel::rows(float s_o, const float*& g0, const float*& g1, float& t) const {

@@ -50,6 +50,7 @@
 
 namespace hairvox {
 
+class DiskCache;
 struct FiberGrid;
 
 /// What the light paths are traced through.
@@ -96,6 +97,9 @@ struct VolumetricScene {
     std::vector<Light> lights;
     std::shared_ptr<const SurfaceScene> surfaces; ///< null: none
     std::vector<Rgb> surfaceAlbedo;               ///< per surface
+    /// Where the fiber types' scattering kernels are kept between processes
+    /// (ScatteringKernel::loadOrBuild); null: built in every solve.
+    const DiskCache* kernelCache = nullptr;
 };
 
 struct VolumetricStats {
