@@ -105,7 +105,7 @@ ScatteringKernel ScatteringKernel::loadOrBuild(const FiberParams& fiber, int ord
     h.value(kFormat).value(order).value(kRows).value(kPanels).value(kPanelPoints);
     h.value(kProjectionPhi).value(kTwistPoints);
     const std::uint64_t key = h.digest();
-    const std::size_t floats = std::size_t(kRows) * 3 * std::size_t((order + 1) * (order + 2) / 2);
+    const std::size_t floats = std::size_t(kRows) * 3 * std::size_t(perChannel(order));
     if (const std::optional<std::vector<std::byte>> bytes = cache->load(kKind, key)) {
         if (bytes->size() == floats * sizeof(float)) {
             std::vector<float> g(floats);

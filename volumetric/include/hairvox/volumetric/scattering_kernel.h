@@ -74,7 +74,8 @@ private:
     /// The two rows around s_o and the weight of the second.
     void rows(float s_o, const float*& g0, const float*& g1, float& t) const;
     /// Values a row holds per channel: G_lm for l ≤ L, 0 ≤ m ≤ l, at l(l + 1)/2 + m.
-    int perChannel() const { return (order_ + 1) * (order_ + 2) / 2; }
+    int perChannel() const { return perChannel(order_); }
+    static int perChannel(int order) { return (order + 1) * (order + 2) / 2; }
 
     int order_;
     std::vector<float> g_; ///< [row][channel][l(l + 1)/2 + m]: G_lm(s_o of the row)
