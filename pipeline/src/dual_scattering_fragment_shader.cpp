@@ -3,6 +3,7 @@
 #include <hairvox/core/math.h>
 #include <hairvox/core/thread_scratch.h>
 #include <hairvox/strands/groom.h>
+#include <hairvox/volumetric/spherical_harmonics.h>
 
 #include <chrono>
 
@@ -38,15 +39,23 @@ void put(float* out, const Rgb& c) {
 DualScatteringFragmentShader::DualScatteringFragmentShader(
     std::vector<DualScatteringShader> shaders, std::span<const std::uint8_t> fiberType,
     std::vector<Light> lights, std::vector<std::shared_ptr<const LightGlobalTerm>> lightTerms,
-    ShadedEnvironment environment, const RadianceCache* multiple)
+    ShadedEnvironment environment, ShadedMultiple multiple)
     : shaders_(std::move(shaders))
     , fiberType_(fiberType)
     , lights_(std::move(lights))
     , terms_(std::move(lightTerms))
     , environment_(std::move(environment))
     , multiple_(multiple)
-    , layout_(hairShaderLayout(lights_, multiple != nullptr))
-    , stats_(lights_.size()) {}
+    , layout_(hairShaderLayout(lights_, multiple.cache != nullptr))
+    , stats_(lights_.size()) {
+    if (const Groom* groom = multiple_.groom) {
+        pointTangents_.resize(groom->points.size());
+        for (std::size_t s = 0; s < groom->strandCount(); ++s) {
+            const std::span<const Vec3f> points = groom->strand(s);
+            strandTangents(points, {pointTangents_.data() + groom->strandStart[s], points.size()});
+        }
+    }
+}
 
 ShaderLayout hairShaderLayout(std::span<const Light> lights, bool multipleScattering) {
     ShaderLayout layout;
@@ -71,7 +80,7 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
     const auto start = std::chrono::steady_clock::now();
     const std::size_t lightCount = lights_.size();
     const std::size_t stride = layout_.stride();
-    const bool volumetric = multiple_ != nullptr;
+    const bool volumetric = multiple_.cache != nullptr;
     const std::size_t radianceFloats = 3 * radianceLayers(volumetric);
     const std::size_t perLight = lightFloats(volumetric);
     std::fill(out.begin(), out.end(), 0.0f);
@@ -201,21 +210,75 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
             put(o, r.directR);
             put(o + 3, r.directTT);
             put(o + 6, r.directTRT);
-            if (volumetric) {
-                const ShadingPoint& p = points[pointOf(t, k)];
-                put(o + 9, multiple_->outgoing(p.position, p.tangent, p.toCamera, t));
-            } else {
+            if (!volumetric) {
                 put(o + 9, r.backDirect);
                 put(o + 12, r.scatter);
             }
         }
     }
+    if (volumetric)
+        shadeMultiple(points, queries, out);
     globalTermNanos_ += globalTermNanos;
     shadeNanos_ += nanosSince(start);
     const std::lock_guard lock(statsMutex_);
     for (std::size_t l = 0; l < lightCount; ++l)
         stats_[l] += batchStats[l];
     environmentStats_ += environmentStats;
+}
+
+void DualScatteringFragmentShader::shadeMultiple(std::span<const ShadingPoint> points,
+                                                 std::span<const GlobalTermQuery> queries,
+                                                 std::span<float> out) const {
+    const RadianceCache& cache = *multiple_.cache;
+    const std::size_t stride = layout_.stride(),
+                      n = 3 * std::size_t(cache.settings().coefficients());
+    const int order = cache.settings().shOrder;
+    struct Scratch {
+        FiberSamplePlan plan;
+        std::vector<ShFrameRotation> frames; ///< per sample
+        std::vector<Vec3f> positions;        ///< per sample
+        std::vector<float> incident;         ///< per sample: n floats in its frame
+    };
+    ThreadScratch<Scratch> scratch;
+    FiberSamplePlan& plan = scratch->plan;
+    std::vector<ShFrameRotation>& frames = scratch->frames;
+    std::vector<Vec3f>& positions = scratch->positions;
+    std::vector<float>& incident = scratch->incident;
+    bool planned = multiple_.groom && multiple_.spacing > 0;
+    if (planned) {
+        plan.plan(queries, *multiple_.groom, multiple_.spacing);
+        // Fragments far apart along their fibers (a groom seen from afar)
+        // need more samples than points: each is then read where it is.
+        planned = plan.samples().size() < points.size();
+    }
+    const std::span<const GlobalTermQuery> samples = planned ? plan.samples() : queries;
+    frames.clear();
+    positions.clear();
+    for (const GlobalTermQuery& q : samples) {
+        Vec3f u = q.tangent;
+        if (planned && q.onFiber && q.segment != kUnknownSegment) {
+            const Vec3f& p0 = multiple_.groom->points[q.segment];
+            const Vec3f d = multiple_.groom->points[q.segment + 1] - p0;
+            const float t = std::clamp(glm::dot(q.position - p0, d) / glm::dot(d, d), 0.0f, 1.0f);
+            u = shadingTangent(pointTangents_[q.segment], pointTangents_[q.segment + 1],
+                               std::isnan(t) ? 0.0f : t, q.tangent);
+        }
+        frames.emplace_back(u, order);
+        positions.push_back(q.position);
+    }
+    incident.resize(samples.size() * n); // every element written by incidentInFrames
+    cache.incidentInFrames(positions, frames, incident.data());
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        const FiberSamplePlan::Where w =
+            planned ? plan.where(i) : FiberSamplePlan::Where{static_cast<std::uint32_t>(i), 0.0f};
+        const std::size_t t = queries[i].fiberType;
+        const Vec3f& omega_o = points[i].toCamera;
+        const float* c = incident.data() + std::size_t(w.sample) * n;
+        Rgb L = cache.outgoingInFrame(c, frames[w.sample], omega_o, t);
+        if (w.f > 0)
+            L = lerp(w.f, L, cache.outgoingInFrame(c + n, frames[w.sample + 1], omega_o, t));
+        put(out.data() + i * stride + 9, L);
+    }
 }
 
 GlobalTermStats DualScatteringFragmentShader::environmentStats() const {

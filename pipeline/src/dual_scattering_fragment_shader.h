@@ -51,6 +51,21 @@ struct ShadedEnvironment {
     float spacing = 0; ///< world units between samples along a fiber; 0: none
 };
 
+/// The volumetric integrator's multiple scattering (radiance_cache.h). With
+/// a groom and a spacing, the cells' light is read at samples along the
+/// fibers (FiberSamplePlan), each in the frame of the fiber's shading tangent
+/// there (strands/groom.h shadingTangent: a blend of 8 cells and a rotation
+/// per sample), and a point's radiance toward its own ω_o is interpolated
+/// between the two samples around it, each contracted with the fiber's kernel
+/// (a rotation is ~6× a contraction; the cache varies over its cells, a
+/// fragment every pixel). Without, or where a batch of points would need
+/// more samples than it has points: at every point, about its own tangent.
+struct ShadedMultiple {
+    const RadianceCache* cache = nullptr; ///< null: dual scattering
+    const Groom* groom = nullptr;         ///< must outlive the shader
+    float spacing = 0;                    ///< world units between samples along a fiber; 0: none
+};
+
 class DualScatteringFragmentShader final : public FragmentShader {
 public:
     /// `shaders[t]` shades fiber type t; `fiberType` is the groom's
@@ -58,14 +73,14 @@ public:
     /// shader). `lightTerms[l]` is the global term toward lights[l], or null
     /// for a light that is skipped (contributes nothing; its AOVs read "blocked").
     /// `environment`: the environment's regions (ShadedEnvironment, above).
-    /// `multiple` (the volumetric integrator; must outlive the shader): the
-    /// multiple scattering comes from it, and the shaders give single
-    /// scattering only (their back_direct and scatter are not read).
+    /// With `multiple`.cache (the volumetric integrator; must outlive the
+    /// shader) the multiple scattering comes from it (ShadedMultiple, above),
+    /// and the shaders give single scattering only (their back_direct and
+    /// scatter are not read).
     DualScatteringFragmentShader(std::vector<DualScatteringShader> shaders,
                                  std::span<const std::uint8_t> fiberType, std::vector<Light> lights,
                                  std::vector<std::shared_ptr<const LightGlobalTerm>> lightTerms,
-                                 ShadedEnvironment environment = {},
-                                 const RadianceCache* multiple = nullptr);
+                                 ShadedEnvironment environment = {}, ShadedMultiple multiple = {});
 
     const ShaderLayout& layout() const override { return layout_; }
     void shade(std::span<const ShadingPoint> points, std::span<float> out) const override;
@@ -84,7 +99,14 @@ private:
     std::vector<Light> lights_;
     std::vector<std::shared_ptr<const LightGlobalTerm>> terms_;
     ShadedEnvironment environment_;
-    const RadianceCache* multiple_;
+    /// The multiple scattering of `points` into out's `multiple` layer
+    /// (ShadedMultiple); `queries` are the points'.
+    void shadeMultiple(std::span<const ShadingPoint> points,
+                       std::span<const GlobalTermQuery> queries, std::span<float> out) const;
+
+    ShadedMultiple multiple_;
+    /// With multiple_.groom: strandTangents() of its points.
+    std::vector<Vec3f> pointTangents_;
     ShaderLayout layout_;
     mutable std::atomic<std::int64_t> globalTermNanos_{0}, shadeNanos_{0};
     mutable std::mutex statsMutex_;

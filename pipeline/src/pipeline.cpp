@@ -29,6 +29,12 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+/// The volumetric integrator's samples along the fibers, in cells
+/// (detail::ShadedMultiple). Measured on key_back.json at 512² against
+/// reading every fragment: the `multiple` layer moves by 0.5% / 1.7% / 4.9%
+/// rel L1 per pixel (bias 0.01–0.02%) at 1/4, 1/2 and 1 cell.
+constexpr float kMultipleSampleCells = 0.5f;
+
 double secondsSince(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -469,9 +475,18 @@ SceneRender renderRasterized(const Scene& scene, const PipelineOptions& options,
     std::vector<DualScatteringShader> shaders;
     for (std::size_t t = 0; t < bcsdfs.size(); ++t)
         shaders.emplace_back(bcsdfs[t], assets->tables[t], shaderParams);
+    // The volumetric integrator's cells read at samples half a cell apart
+    // along the fibers (detail::ShadedMultiple): its values are trilinear
+    // between the cells' centres.
+    detail::ShadedMultiple shadedMultiple;
+    if (cache) {
+        shadedMultiple.cache = cache;
+        shadedMultiple.groom = &groom.groom;
+        shadedMultiple.spacing = kMultipleSampleCells * cache->cellSize();
+    }
     const detail::DualScatteringFragmentShader fragmentShader(
         std::move(shaders), groom.groom.fiberType, scene.lights, std::move(terms),
-        std::move(shadedEnvironment), cache);
+        std::move(shadedEnvironment), shadedMultiple);
     RasterOutput image = rasterize(groom.groom, camera, fragmentShader,
                                    rasterSettings(scene, options), surfaces, background);
     result.film = std::move(image.film);

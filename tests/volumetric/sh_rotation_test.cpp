@@ -1,3 +1,5 @@
+#include "test_util.h"
+
 #include <hairvox/core/rng.h>
 #include <hairvox/core/sampling.h>
 #include <hairvox/volumetric/sh_rotation.h>
@@ -7,6 +9,8 @@
 
 #include <array>
 #include <cmath>
+#include <cstring>
+#include <stdexcept>
 #include <vector>
 
 namespace hairvox {
@@ -69,6 +73,38 @@ TEST(ShFrameRotation, KeepsEachBandsEnergy) {
         }
         EXPECT_NEAR(b, a, 1e-5 * a) << "band " << l;
     }
+}
+
+TEST(ShFrameRotation, LanesRotateEachFrameAsItAloneAndEveryTargetAlike) {
+    // 13 frames in one call (lanes 13–15 unused), 3 channels: each lane must
+    // be that frame's apply() bit for bit, on every SIMD target the host runs.
+    constexpr std::size_t K = ShFrameRotation::kLanes, frames = 13;
+    Pcg32 rng(11);
+    std::vector<ShFrameRotation> f;
+    std::vector<float> in(3 * nc * K), planar(frames * 3 * nc);
+    for (std::size_t k = 0; k < frames; ++k) {
+        f.emplace_back(
+            k == 0 ? Vec3f(0, 0, 1) : uniformSphere(rng.uniformFloat(), rng.uniformFloat()), L);
+        for (int i = 0; i < 3 * nc; ++i)
+            planar[k * 3 * nc + std::size_t(i)] = in[std::size_t(i) * K + k] = rng.uniform(-1, 1);
+    }
+    const auto lanes = [&] {
+        std::vector<float> out(3 * nc * K);
+        ShFrameRotation::applyLanes(f, in.data(), out.data(), 3);
+        std::vector<float> used;
+        for (std::size_t k = 0; k < frames; ++k)
+            for (int i = 0; i < 3 * nc; ++i)
+                used.push_back(out[std::size_t(i) * K + k]);
+        return used;
+    };
+    std::vector<float> alone(frames * 3 * nc);
+    for (std::size_t k = 0; k < frames; ++k)
+        f[k].apply(planar.data() + k * 3 * nc, alone.data() + k * 3 * nc, 3);
+    EXPECT_EQ(std::memcmp(lanes().data(), alone.data(), alone.size() * sizeof(float)), 0);
+    test::forEachSimdTarget([&] {
+        EXPECT_EQ(std::memcmp(lanes().data(), alone.data(), alone.size() * sizeof(float)), 0);
+    });
+    EXPECT_THROW(ShFrameRotation::applyLanes({}, in.data(), in.data(), 1), std::invalid_argument);
 }
 
 } // namespace

@@ -22,6 +22,7 @@ constexpr float kQuarterPi = float(Pi / 4.0);
 
 FiberMedium::FiberMedium(const FiberGrid& grid)
     : grid_(&grid)
+    , density_(grid.density.data())
     , h_(float(grid.info.voxelSize))
     , kD_(grid.info.fiberScale.ribbonWidth())
     , types_(grid.fiberTypeCount()) {
@@ -49,7 +50,6 @@ FiberMedium::FiberMedium(const FiberGrid& grid)
                                 " blocks of 8 voxels: too sparse a groom for the volumetric "
                                 "integrator; raise the voxel size"));
     blockIndex_.assign(cells, -1);
-    majorant_.resize(grid.blocks.size());
     prefix_.resize(grid.blocks.size());
     using Word = openvdb::Index64;
     for (std::size_t b = 0; b < grid.blocks.size(); ++b) {
@@ -66,12 +66,6 @@ FiberMedium::FiberMedium(const FiberGrid& grid)
             count = static_cast<std::uint16_t>(
                 count + openvdb::util::CountOn(block.active.getWord<Word>(openvdb::Index(w))));
         }
-        float maxSigma = 0;
-        FiberGrid::forEachVoxelOf(block, [&](std::size_t v, const openvdb::Coord&) {
-            const float coherence = std::min(1.0f, grid.orientation[v].length());
-            maxSigma = std::max(maxSigma, grid.density[v] * (coherence + (1.0f - coherence) * kQuarterPi));
-        });
-        majorant_[b] = kD_ * maxSigma;
         const Vec3f lo3 = (Vec3f(block.origin.x(), block.origin.y(), block.origin.z()) - 0.5f) * h_;
         bounds_.extend(lo3);
         bounds_.extend(lo3 + float(kBlockDim) * h_);
@@ -219,41 +213,8 @@ float FiberMedium::ownDensity(const OwnFiber& own, const glm::ivec3& v) const {
 std::optional<MediumCollision> FiberMedium::sampleCollision(const Vec3f& origin, const Vec3f& dir,
                                                             float tMax, Pcg32& rng,
                                                             const OwnFiber* own) const {
-    // The own fiber's cross-section toward dir: k·D·|dir × u| per unit λ_own.
-    const float ownCross = own ? kD_ * glm::length(glm::cross(dir, own->tangent)) : 0.0f;
-    const float ownReach = own ? ownFiberReach(*own, dir) : 0.0f;
-    std::optional<MediumCollision> hit;
-    walkBlocks(origin, dir, tMax, [&](std::int32_t block, float tEnter, float tExit) {
-        const float majorant = majorant_[std::size_t(block)];
-        if (!(majorant > 0))
-            return true;
-        for (float t = tEnter;;) {
-            t -= std::log1p(-rng.uniformFloat()) / majorant;
-            if (!(t < tExit))
-                return true;
-            const Vec3f x = origin + t * dir;
-            const Vec3f q = x / h_ + 0.5f;
-            const std::int64_t v = voxelAt(q);
-            if (v < 0)
-                continue;
-            float sigma =
-                kD_ * grid_->density[std::size_t(v)] * meanCosTheta(std::size_t(v), dir);
-            if (ownCross > 0 && t < ownReach) {
-                const glm::ivec3 ijk(floorToInt(q.x), floorToInt(q.y), floorToInt(q.z));
-                if (nearOwnFiber(*own, ijk))
-                    sigma -= ownCross * ownDensity(*own, ijk);
-            }
-            if (rng.uniformFloat() * majorant < sigma) {
-                MediumCollision c;
-                c.t = t;
-                c.position = x;
-                sampleFiber(std::size_t(v), dir, rng, c);
-                hit = c;
-                return false;
-            }
-        }
-    });
-    return hit;
+    return sampleCollision(origin, dir, tMax, rng, own,
+                           [](std::size_t, const glm::ivec3&, float, float, float) {});
 }
 
 std::ostream& operator<<(std::ostream& os, const MediumCollision& c) {

@@ -1,5 +1,3 @@
-#include <hairvox/volumetric/multiple_scattering.h>
-
 #include "light_emission.h"
 
 #include <hairvox/core/error.h>
@@ -12,9 +10,12 @@
 #include <hairvox/core/sampling.h>
 #include <hairvox/shading/marschner.h>
 #include <hairvox/volumetric/fiber_medium.h>
+#include <hairvox/volumetric/multiple_scattering.h>
+#include <hairvox/volumetric/spherical_harmonics.h>
 #include <hairvox/voxelize/fiber_grid.h>
 
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <chrono>
@@ -28,7 +29,10 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 constexpr std::uint64_t kChunkPaths = 1024; ///< paths a task traces together
-constexpr std::size_t kBatchChunks = 64;    ///< chunks traced before their deposits are added
+/// Chunks traced before their deposits are added, per thread (at least 16):
+/// a chunk's record holds its flights' basis values, ~0.8 MB. The result
+/// does not depend on it (each cell takes its deposits in chunk order).
+constexpr std::size_t kBatchChunksPerThread = 4;
 constexpr std::size_t kMaxBuckets = 256;    ///< cell ranges the deposits are added by
 
 double secondsSince(Clock::time_point start) {
@@ -48,7 +52,6 @@ struct Ray {
 
 /// One flight of a path after its first scattering, and its crossings.
 struct Flight {
-    Vec3f omega_i; ///< toward where the light comes from (−direction of flight)
     Rgb power;
 };
 struct Crossing {
@@ -66,10 +69,21 @@ struct SurfaceDeposit {
 /// (bucketStart[b] .. bucketStart[b + 1]), its surface deposits, and its counts.
 struct ChunkRecord {
     std::vector<Flight> flights;
+    /// Per flight, Y_lm(ω_i) ((L + 1)² floats; ω_i toward where the light
+    /// comes from, −direction of flight): evaluated once for its crossings.
+    std::vector<float> basis;
     std::vector<Crossing> crossings;
+    std::vector<Crossing> sorted; ///< the crossings grouped by bucket (kept: no page faults)
     std::vector<std::uint32_t> bucketStart;
     std::vector<SurfaceDeposit> surfaceDeposits;
     VolumetricStats counts;
+
+    void addFlight(const Vec3f& omega_i, const Rgb& power, int order) {
+        flights.push_back({power});
+        const std::size_t nc = std::size_t(SphericalHarmonics::coefficients(order));
+        basis.resize(basis.size() + nc);
+        SphericalHarmonics::evaluate(omega_i, order, basis.data() + basis.size() - nc);
+    }
 };
 
 class PathTracer {
@@ -166,15 +180,22 @@ private:
                     surface = surfaces->intersect(ray.origin, ray.dir,
                                                   std::numeric_limits<float>::infinity());
                 tSurface = surface ? surface->t : std::numeric_limits<float>::infinity();
-                hit = medium_.sampleCollision(ray.origin, ray.dir, tSurface, rng,
-                                              own ? &*own : nullptr);
+                // From its first scattering on, the flight's deposits ride along.
+                if (scattered) {
+                    Deposits deposits(*this, record);
+                    hit = medium_.sampleCollision(ray.origin, ray.dir, tSurface, rng,
+                                                  own ? &*own : nullptr, deposits);
+                    deposits.finish(ray.dir, power);
+                } else {
+                    hit = medium_.sampleCollision(ray.origin, ray.dir, tSurface, rng);
+                }
                 if (hit)
                     surface.reset();
             }
             if (surface)
                 from.reset();
-            if (scattered)
-                deposit(ray, hit ? hit->t : tSurface, power, own ? &*own : nullptr, record);
+            if (scattered && rays_)
+                depositAlong(ray, hit ? hit->t : tSurface, power, record);
             if (surface && scattered && surfaceCells_) {
                 const Vec3f x = ray.origin + surface->t * ray.dir;
                 if (const std::int64_t slot = surfaceCells_->slotAt(x); slot >= 0)
@@ -224,37 +245,55 @@ private:
         c.deepestPath = std::max(c.deepestPath, events);
     }
 
-    /// The flight origin + t·dir, t ∈ [0, tEnd], into the cells it crosses:
-    /// ∫ λ dt over each run of its voxels in one cell, without the share of
-    /// `own`, the fiber it leaves (null: none; fiber_medium.h).
-    void deposit(const Ray& ray, float tEnd, const Rgb& power, const OwnFiber* own,
-                 ChunkRecord& record) const {
-        const auto flight = static_cast<std::uint32_t>(record.flights.size());
-        const std::size_t first = record.crossings.size();
-        std::int64_t slot = -1;
-        float sum = 0;
-        const auto flush = [&] {
-            if (slot >= 0 && sum > 0)
-                record.crossings.push_back({std::uint32_t(slot), flight, sum});
-        };
-        const FiberGrid& grid = medium_.grid();
-        const float ownReach = own ? medium_.ownFiberReach(*own, ray.dir) : 0.0f;
+    /// A flight's crossings (FiberMedium::sampleCollision's `crossed`): ∫ λ dt
+    /// over each run of its voxels in one cell, the λ without the share of
+    /// the fiber it leaves (fiber_medium.h).
+    class Deposits {
+    public:
+        Deposits(const PathTracer& tracer, ChunkRecord& record)
+            : cache_(tracer.cache_)
+            , record_(record)
+            , flight_(static_cast<std::uint32_t>(record.flights.size()))
+            , first_(record.crossings.size()) {}
+        void operator()(std::size_t, const glm::ivec3& ijk, float lambda, float t0, float t1) {
+            const std::int64_t s = cache_.slotOfVoxel(ijk);
+            if (s != slot_) {
+                flush();
+                slot_ = s;
+                sum_ = 0;
+            }
+            sum_ += lambda * (t1 - t0);
+        }
+        /// Ends the flight: its record, if it crossed any cell.
+        void finish(const Vec3f& dir, const Rgb& power) {
+            flush();
+            if (record_.crossings.size() > first_)
+                record_.addFlight(-dir, power, cache_.settings().shOrder);
+        }
+
+    private:
+        void flush() {
+            if (slot_ >= 0 && sum_ > 0)
+                record_.crossings.push_back({std::uint32_t(slot_), flight_, sum_});
+        }
+        const RadianceCache& cache_;
+        ChunkRecord& record_;
+        std::uint32_t flight_;
+        std::size_t first_;
+        std::int64_t slot_ = -1;
+        float sum_ = 0;
+    };
+
+    /// The fibers transport's flight origin + t·dir, t ∈ [0, tEnd], into the
+    /// cells it crosses (the strands themselves are met by rays: no fiber is
+    /// left out of λ).
+    void depositAlong(const Ray& ray, float tEnd, const Rgb& power, ChunkRecord& record) const {
+        Deposits deposits(*this, record);
         medium_.walkVoxels(ray.origin, ray.dir, tEnd,
                            [&](std::size_t v, const glm::ivec3& ijk, float t0, float t1) {
-                               const std::int64_t s = cache_.slotOfVoxel(ijk);
-                               if (s != slot) {
-                                   flush();
-                                   slot = s;
-                                   sum = 0;
-                               }
-                               float lambda = grid.density[v];
-                               if (t0 < ownReach && medium_.nearOwnFiber(*own, ijk))
-                                   lambda = std::max(0.0f, lambda - medium_.ownDensity(*own, ijk));
-                               sum += lambda * (t1 - t0);
+                               deposits(v, ijk, medium_.grid().density[v], t0, t1);
                            });
-        flush();
-        if (record.crossings.size() > first)
-            record.flights.push_back({-ray.dir, power});
+        deposits.finish(ray.dir, power);
     }
 
     const VolumetricScene& scene_;
@@ -371,15 +410,18 @@ MultipleScatteringSolution solveMultipleScattering(const VolumetricScene& scene,
     const std::size_t bucketSlots = (slots + buckets - 1) / std::max<std::size_t>(buckets, 1);
 
     ProgressReporter progress("multiple scattering", paths, settings.progress);
-    std::vector<ChunkRecord> records(kBatchChunks);
-    for (std::size_t batch = 0; batch < chunks.size(); batch += kBatchChunks) {
-        const std::size_t n = std::min(kBatchChunks, chunks.size() - batch);
+    const std::size_t batchChunks = std::max<std::size_t>(
+        16, kBatchChunksPerThread * std::size_t(tbb::this_task_arena::max_concurrency()));
+    std::vector<ChunkRecord> records(batchChunks);
+    for (std::size_t batch = 0; batch < chunks.size(); batch += batchChunks) {
+        const std::size_t n = std::min(batchChunks, chunks.size() - batch);
         tbb::parallel_for(std::size_t(0), n, [&](std::size_t k) {
             throwIfInterrupted();
             flushDenormalsToZero();
             const Chunk& chunk = chunks[batch + k];
             ChunkRecord& r = records[k];
             r.flights.clear();
+            r.basis.clear();
             r.crossings.clear();
             r.surfaceDeposits.clear();
             r.counts = {};
@@ -391,20 +433,21 @@ MultipleScatteringSolution solveMultipleScattering(const VolumetricScene& scene,
                 ++r.bucketStart[x.slot / bucketSlots + 1];
             for (std::size_t b = 0; b < buckets; ++b)
                 r.bucketStart[b + 1] += r.bucketStart[b];
-            std::vector<Crossing> sorted(r.crossings.size());
+            r.sorted.resize(r.crossings.size());
             std::vector<std::uint32_t> next(r.bucketStart.begin(), r.bucketStart.end() - 1);
             for (const Crossing& x : r.crossings)
-                sorted[next[x.slot / bucketSlots]++] = x;
-            r.crossings.swap(sorted);
+                r.sorted[next[x.slot / bucketSlots]++] = x;
+            r.crossings.swap(r.sorted);
             progress.update(chunk.end - chunk.begin);
         });
+        const std::size_t nc = std::size_t(settings.cache.coefficients());
         tbb::parallel_for(std::size_t(0), buckets, [&](std::size_t b) {
             for (std::size_t k = 0; k < n; ++k) {
                 const ChunkRecord& r = records[k];
                 for (std::uint32_t i = r.bucketStart[b]; i < r.bucketStart[b + 1]; ++i) {
                     const Crossing& x = r.crossings[i];
-                    const Flight& f = r.flights[x.flight];
-                    cache.deposit(x.slot, f.omega_i, f.power * x.weight);
+                    cache.deposit(x.slot, r.basis.data() + std::size_t(x.flight) * nc,
+                                  r.flights[x.flight].power * x.weight);
                 }
             }
         });

@@ -131,16 +131,20 @@ std::int64_t RadianceCache::slotOfVoxel(const glm::ivec3& v) const {
 }
 
 void RadianceCache::deposit(std::uint32_t slot, const Vec3f& omega_i, const Rgb& sample) {
-    const int nc = settings_.coefficients();
     std::array<float, SphericalHarmonics::kMaxCoefficients> y;
     SphericalHarmonics::evaluate(omega_i, settings_.shOrder, y.data());
+    deposit(slot, y.data(), sample);
+}
+
+void RadianceCache::deposit(std::uint32_t slot, const float* y, const Rgb& sample) {
+    const int nc = settings_.coefficients();
     float* c = coefficients_.data() + std::size_t(slot) * floatsPerCell();
     const float inv = 1.0f / fiberLength_[slot];
     for (int ch = 0; ch < 3; ++ch) {
         const float w = sample[ch] * inv;
         float* cc = c + ch * nc;
         for (int m = 0; m < nc; ++m)
-            cc[m] += w * y[std::size_t(m)];
+            cc[m] += w * y[m];
     }
 }
 
@@ -169,14 +173,41 @@ bool RadianceCache::blend(const Vec3f& x, float* out) const {
 
 Rgb RadianceCache::outgoing(const Vec3f& x, const Vec3f& u, const Vec3f& omega_o,
                             std::size_t type) const {
-    if (cells_.empty())
-        return Rgb(0.0f);
-    if (type >= kernels_.size())
-        throw std::invalid_argument("RadianceCache::outgoing: no kernel for the fiber type");
+    const ShFrameRotation frame(u, settings_.shOrder);
     std::array<float, 3 * SphericalHarmonics::kMaxCoefficients> c;
-    if (!blend(x, c.data()))
-        return Rgb(0.0f);
-    const Rgb sum = kernels_[type].apply(c.data(), u, omega_o);
+    incidentInFrames({&x, 1}, {&frame, 1}, c.data());
+    return outgoingInFrame(c.data(), frame, omega_o, type);
+}
+
+void RadianceCache::incidentInFrames(std::span<const Vec3f> x,
+                                     std::span<const ShFrameRotation> frames, float* out) const {
+    if (frames.size() != x.size())
+        throw std::invalid_argument("RadianceCache::incidentInFrames: one frame a point");
+    constexpr std::size_t kLanes = ShFrameRotation::kLanes;
+    const std::size_t n = floatsPerCell();
+    // The blends lane-interleaved, [channel][lm][lane], rotated together.
+    alignas(64) std::array<float, 3 * SphericalHarmonics::kMaxCoefficients * kLanes> in{}, rotated;
+    std::array<float, 3 * SphericalHarmonics::kMaxCoefficients> c;
+    for (std::size_t first = 0; first < x.size(); first += kLanes) {
+        const std::size_t count = std::min(kLanes, x.size() - first);
+        for (std::size_t lane = 0; lane < count; ++lane) {
+            if (cells_.empty() || !blend(x[first + lane], c.data()))
+                std::fill(c.begin(), c.begin() + std::ptrdiff_t(n), 0.0f);
+            for (std::size_t i = 0; i < n; ++i)
+                in[i * kLanes + lane] = c[i];
+        }
+        ShFrameRotation::applyLanes(frames.subspan(first, count), in.data(), rotated.data(), 3);
+        for (std::size_t lane = 0; lane < count; ++lane)
+            for (std::size_t i = 0; i < n; ++i)
+                out[(first + lane) * n + i] = rotated[i * kLanes + lane];
+    }
+}
+
+Rgb RadianceCache::outgoingInFrame(const float* c, const ShFrameRotation& frame,
+                                   const Vec3f& omega_o, std::size_t type) const {
+    if (type >= kernels_.size())
+        throw std::invalid_argument("RadianceCache::outgoingInFrame: no kernel for the fiber type");
+    const Rgb sum = kernels_[type].applyInFrame(c, frame, omega_o);
     return {std::max(0.0f, sum.r), std::max(0.0f, sum.g), std::max(0.0f, sum.b)};
 }
 

@@ -143,10 +143,15 @@ void ScatteringKernel::fiberFrameCoefficients(float s_o, float* k) const {
 }
 
 Rgb ScatteringKernel::apply(const float* coefficients, const Vec3f& u, const Vec3f& omega_o) const {
-    const int nc = SphericalHarmonics::coefficients(order_), ng = perChannel();
     const ShFrameRotation frame(u, order_);
     std::array<float, 3 * SphericalHarmonics::kMaxCoefficients> c;
     frame.apply(coefficients, c.data(), 3);
+    return applyInFrame(c.data(), frame, omega_o);
+}
+
+Rgb ScatteringKernel::applyInFrame(const float* c, const ShFrameRotation& frame,
+                                   const Vec3f& omega_o) const {
+    const int nc = SphericalHarmonics::coefficients(order_), ng = perChannel();
     // cos mφ_o, sin mφ_o from ω_o's azimuth about u (any when ω_o is along u: then K has no
     // m > 0 terms).
     const float x = glm::dot(omega_o, frame.e1()), y = glm::dot(omega_o, frame.e2());
@@ -163,10 +168,10 @@ Rgb ScatteringKernel::apply(const float* coefficients, const Vec3f& u, const Vec
     }
     const float *g0, *g1;
     float t;
-    rows(glm::dot(omega_o, u), g0, g1, t);
+    rows(glm::dot(omega_o, frame.u()), g0, g1, t);
     Rgb out(0.0f);
     for (int ch = 0; ch < 3; ++ch) {
-        const float* cc = c.data() + ch * nc;
+        const float* cc = c + ch * nc;
         const float* a = g0 + ch * ng;
         const float* b = g1 + ch * ng;
         float sum = 0;

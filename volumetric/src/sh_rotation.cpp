@@ -1,8 +1,12 @@
+#include "sh_rotation_lanes.h"
+
 #include <hairvox/core/error.h>
 #include <hairvox/core/gauss_legendre.h>
 #include <hairvox/core/math.h>
 #include <hairvox/volumetric/sh_rotation.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
@@ -72,19 +76,6 @@ std::size_t quarterTurnEntries(int order) {
     return n;
 }
 
-/// g ↦ g∘R_z(θ) in place on one expansion (see the header).
-void rotateZ(float* c, int order, const float* cosM, const float* sinM) {
-    for (int l = 1; l <= order; ++l)
-        for (int m = 1; m <= l; ++m) {
-            float& a = c[SphericalHarmonics::index(l, m)];
-            float& b = c[SphericalHarmonics::index(l, -m)];
-            const float cm = cosM[m], sm = sinM[m];
-            const float na = a * cm + b * sm;
-            b = b * cm - a * sm;
-            a = na;
-        }
-}
-
 /// cos mθ, sin mθ for m ≤ order from cos θ, sin θ (de Moivre).
 void multiples(float c, float s, int order, float* cosM, float* sinM) {
     cosM[0] = 1;
@@ -98,7 +89,8 @@ void multiples(float c, float s, int order, float* cosM, float* sinM) {
 } // namespace
 
 ShFrameRotation::ShFrameRotation(const Vec3f& u, int order)
-    : order_(order) {
+    : order_(order)
+    , u_(u) {
     if (order < 1 || order > kMaxOrder)
         throw std::invalid_argument("ShFrameRotation: order outside [1, kMaxOrder]");
     const float sinB = std::sqrt(u.x * u.x + u.y * u.y), cosB = u.z;
@@ -115,7 +107,25 @@ ShFrameRotation::ShFrameRotation(const Vec3f& u, int order)
 }
 
 void ShFrameRotation::apply(const float* in, float* out, int channels) const {
-    const int nc = SphericalHarmonics::coefficients(order_);
+    // One lane of applyLanes(): the one place of the rotation's arithmetic.
+    const std::size_t nc = std::size_t(SphericalHarmonics::coefficients(order_));
+    alignas(64) std::array<float, 3 * kMaxCoefficients * kLanes> lanesIn{}, lanesOut;
+    for (int ch = 0; ch < channels; ch += 3) {
+        const int n = std::min(3, channels - ch);
+        for (std::size_t i = 0; i < std::size_t(n) * nc; ++i)
+            lanesIn[i * kLanes] = in[std::size_t(ch) * nc + i];
+        applyLanes({this, 1}, lanesIn.data(), lanesOut.data(), n);
+        for (std::size_t i = 0; i < std::size_t(n) * nc; ++i)
+            out[std::size_t(ch) * nc + i] = lanesOut[i * kLanes];
+    }
+}
+
+void ShFrameRotation::applyLanes(std::span<const ShFrameRotation> frames, const float* in,
+                                 float* out, int channels) {
+    if (frames.empty() || frames.size() > kLanes)
+        throw std::invalid_argument("ShFrameRotation::applyLanes: 1 to kLanes frames");
+    detail::ShLaneRotation r;
+    r.order = frames[0].order_;
     const QuarterTurn& q = quarterTurn();
     static const std::array<std::size_t, kMaxOrder + 1> entries = [] {
         std::array<std::size_t, kMaxOrder + 1> n{};
@@ -123,23 +133,23 @@ void ShFrameRotation::apply(const float* in, float* out, int channels) const {
             n[std::size_t(l)] = quarterTurnEntries(l);
         return n;
     }();
-    const std::size_t n = entries[std::size_t(order_)];
-    std::array<float, kMaxCoefficients> t{};
-    for (int ch = 0; ch < channels; ++ch) {
-        const float* c = in + ch * nc;
-        float* o = out + ch * nc;
-        // R_z(α), then Q.
-        std::copy(c, c + nc, o);
-        rotateZ(o, order_, cosA_.data(), sinA_.data());
-        std::fill(t.begin(), t.begin() + nc, 0.0f);
-        for (std::size_t k = 0; k < n; ++k)
-            t[q.row[k]] += q.value[k] * o[q.col[k]];
-        // R_z(β), then Q⁻¹ = Qᵀ.
-        rotateZ(t.data(), order_, cosB_.data(), sinB_.data());
-        std::fill(o, o + nc, 0.0f);
-        for (std::size_t k = 0; k < n; ++k)
-            o[q.col[k]] += q.value[k] * t[q.row[k]];
+    r.row = q.row.data();
+    r.col = q.col.data();
+    r.value = q.value.data();
+    r.entries = entries[std::size_t(r.order)];
+    for (std::size_t lane = 0; lane < kLanes; ++lane) {
+        // Lanes past the frames rotate by the last frame (their values are not read).
+        const ShFrameRotation& f = frames[std::min(lane, frames.size() - 1)];
+        if (f.order_ != r.order)
+            throw std::invalid_argument("ShFrameRotation::applyLanes: frames of different orders");
+        for (int m = 0; m <= r.order; ++m) {
+            r.cosA[m][lane] = f.cosA_[std::size_t(m)];
+            r.sinA[m][lane] = f.sinA_[std::size_t(m)];
+            r.cosB[m][lane] = f.cosB_[std::size_t(m)];
+            r.sinB[m][lane] = f.sinB_[std::size_t(m)];
+        }
     }
+    detail::rotateLanes(r, in, out, channels);
 }
 
 } // namespace hairvox

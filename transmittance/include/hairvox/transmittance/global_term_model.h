@@ -169,13 +169,17 @@ public:
     /// (values.size() == samples().size(), out.size() == the queries').
     void interpolate(std::span<const GlobalTerm> values, std::span<GlobalTerm> out) const;
 
-private:
-    /// Per query: the sample at or below it (an index into samples_) and the
-    /// fraction toward the next one.
+    /// How a query is read: the sample at or below it (an index into
+    /// samples()) and the fraction toward the next one, a sample of the same
+    /// segment with the same tangent (f = 0: that sample alone).
     struct Where {
         std::uint32_t sample;
         float f;
     };
+    /// Query j's (for values other than GlobalTerm: interpolate() reads it so).
+    Where where(std::size_t j) const { return where_[j]; }
+
+private:
     std::vector<GlobalTermQuery> samples_;
     std::vector<Where> where_; ///< every element written before it is read
     std::vector<int> needed_;  ///< sample numbers along the current segment

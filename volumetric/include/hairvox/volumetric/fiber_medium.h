@@ -18,12 +18,15 @@
 // Σ λ_v h³ is kept; the trilinear field of the global term would cost eight
 // lookups per tentative collision for the same integral).
 //
-// Collisions. sampleCollision() draws the distance to the next fiber met with
-// delta tracking (Woodcock): the ray walks the fiber grid's 8³ blocks
-// (core/grid_traversal.h), skipping those without fibers, and inside a block
-// proposes collisions at the block's majorant max_v σ_v·(c_v + (1 − c_v)π/4),
-// accepting each with probability σ_t(x, ω)/majorant. Unbiased for any
-// majorant that bounds σ_t, which this one does for every ω.
+// Collisions. sampleCollision() draws the distance to the next fiber met by
+// regular tracking: σ_t is constant in each voxel's box, so the flight walks
+// the voxels it crosses in order (core/grid_traversal.h; blocks without
+// fibers passed whole), summing σ_t·Δt until the optical depth reaches
+// τ = −ln(1 − ξ), and meets its fiber inside the voxel where it does — the
+// exact distribution, one random number a flight. (Replaced: delta tracking
+// at each 8³ block's majorant, a logarithm, a voxel lookup and a random
+// number per tentative collision; the walk visited the same voxels again for
+// the flight's deposits, which now ride along: sampleCollision's `crossed`.)
 //
 // Scattering. The collision meets one fiber, drawn in proportion to the
 // cross-section it shows the ray: the voxel's mean direction u = o/c with
@@ -49,10 +52,13 @@
 #include <hairvox/core/vecmath.h>
 #include <hairvox/strands/fiber_scale.h>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <ostream>
+#include <type_traits>
 #include <vector>
 
 namespace hairvox {
@@ -87,10 +93,18 @@ public:
     /// The next fiber a ray from `origin` along unit `dir` meets before
     /// `tMax`, or nothing (the ray leaves the hair, or reaches tMax first);
     /// never `own`, the fiber the ray leaves (null: none). Draws from `rng`
-    /// (delta tracking and the fiber's orientation and type).
+    /// (the optical depth to the collision, the fiber's orientation and type).
     std::optional<MediumCollision> sampleCollision(const Vec3f& origin, const Vec3f& dir,
                                                    float tMax, Pcg32& rng,
                                                    const OwnFiber* own = nullptr) const;
+    /// The same, calling crossed(value index, voxel, λ, t0, t1) for each run
+    /// [t0, t1] of an active voxel (index space) the ray crosses before the collision (or tMax), in
+    /// order, λ the voxel's fiber density without own's share (clamped at
+    /// 0): what the track-length estimates of the flight integrate.
+    template <typename Crossed>
+    std::optional<MediumCollision> sampleCollision(const Vec3f& origin, const Vec3f& dir,
+                                                   float tMax, Pcg32& rng, const OwnFiber* own,
+                                                   Crossed&& crossed) const;
 
     /// λ_own,v (fiber length per volume): the share of voxel v (index space)
     /// that the splat of the straight fiber `own` holds (see above).
@@ -104,8 +118,8 @@ public:
 
     /// Calls visit(value index, voxel, tEnter, tExit) for every active voxel
     /// the segment origin + t·dir, t ∈ [0, tEnd], crosses, in order (unit
-    /// dir; voxels hold their value over the box around their vertex). Blocks
-    /// without fibers are passed whole.
+    /// dir; voxels hold their value over the box around their vertex), while
+    /// visit returns true (or void). Blocks without fibers are passed whole.
     template <typename Visit>
     void walkVoxels(const Vec3f& origin, const Vec3f& dir, float tEnd, Visit&& visit) const;
 
@@ -135,6 +149,7 @@ private:
     float meanCosTheta(std::size_t v, const Vec3f& omega) const;
 
     const FiberGrid* grid_;
+    const float* density_; ///< the grid's λ per voxel value
     float h_ = 1, kD_ = 0;
     std::size_t types_ = 1;
     Bounds3f bounds_;
@@ -142,7 +157,6 @@ private:
     /// [blockMin_, blockMin_ + blockDims_): index into grid_->blocks, or -1.
     glm::ivec3 blockMin_{0}, blockDims_{0};
     std::vector<std::int32_t> blockIndex_;
-    std::vector<float> majorant_;                       ///< per block
     std::vector<std::array<std::uint16_t, 8>> prefix_; ///< per block: active voxels before each mask word
 };
 
@@ -185,16 +199,54 @@ template <typename Visit>
 void FiberMedium::walkVoxels(const Vec3f& origin, const Vec3f& dir, float tEnd,
                              Visit&& visit) const {
     const GridLine<float> line(origin / h_ + 0.5f, dir / h_);
+    bool going = true;
     walkBlocks(origin, dir, tEnd, [&](std::int32_t block, float tEnter, float tExit) {
         const glm::ivec3 lo = blockOrigin(block);
-        traverseCells(line, tEnter, tExit, lo, lo + 7,
-                      [&](const glm::ivec3& v, float t0, float t1) {
-                          if (const std::int64_t i = voxelIn(block, v); i >= 0)
-                              visit(std::size_t(i), v, t0, t1);
-                          return true;
-                      });
-        return true;
+        traverseCells(
+            line, tEnter, tExit, lo, lo + 7, [&](const glm::ivec3& v, float t0, float t1) {
+                if (const std::int64_t i = voxelIn(block, v); i >= 0) {
+                    if constexpr (std::is_void_v<decltype(visit(std::size_t(i), v, t0, t1))>)
+                        visit(std::size_t(i), v, t0, t1);
+                    else
+                        going = visit(std::size_t(i), v, t0, t1);
+                }
+                return going;
+            });
+        return going;
     });
+}
+
+template <typename Crossed>
+std::optional<MediumCollision>
+FiberMedium::sampleCollision(const Vec3f& origin, const Vec3f& dir, float tMax, Pcg32& rng,
+                             const OwnFiber* own, Crossed&& crossed) const {
+    // The own fiber's cross-section toward dir, per unit λ_own: |dir × u|.
+    const float ownCross = own ? glm::length(glm::cross(dir, own->tangent)) : 0.0f;
+    const float ownReach = own ? ownFiberReach(*own, dir) : 0.0f;
+    float tau = -std::log1p(-rng.uniformFloat()); // the optical depth left to the collision
+    std::optional<MediumCollision> hit;
+    walkVoxels(origin, dir, tMax, [&](std::size_t v, const glm::ivec3& ijk, float t0, float t1) {
+        const float lambda = density_[v];
+        const float lambdaOwn =
+            own && t0 < ownReach && nearOwnFiber(*own, ijk) ? ownDensity(*own, ijk) : 0.0f;
+        const float sigma =
+            std::max(0.0f, kD_ * (lambda * meanCosTheta(v, dir) - ownCross * lambdaOwn));
+        const float depth = sigma * (t1 - t0);
+        const float lambdaMet = std::max(0.0f, lambda - lambdaOwn);
+        if (!(sigma > 0) || depth < tau) {
+            tau -= depth;
+            crossed(v, ijk, lambdaMet, t0, t1);
+            return true;
+        }
+        MediumCollision c;
+        c.t = std::min(t1, t0 + tau / sigma);
+        c.position = origin + c.t * dir;
+        crossed(v, ijk, lambdaMet, t0, c.t);
+        sampleFiber(v, dir, rng, c);
+        hit = c;
+        return false;
+    });
+    return hit;
 }
 
 } // namespace hairvox

@@ -35,7 +35,10 @@
 // around x trilinearly (cells without fibers left out and the weights
 // renormalised) and applies the fragment's own fiber type's scattering
 // kernel about the fragment's own tangent (scattering_kernel.h): every lobe
-// in the fiber's frame, exact for the order held.
+// in the fiber's frame, exact for the order held. incidentInFrames() and
+// outgoingInFrame() are its two halves, for a reader that rotates once for
+// several fragments and rotates many frames at once (the pipeline's
+// samples along the fibers).
 #pragma once
 
 #include <hairvox/core/large_array.h>
@@ -43,9 +46,11 @@
 #include <hairvox/core/vecmath.h>
 #include <hairvox/volumetric/cell_grid.h>
 #include <hairvox/volumetric/scattering_kernel.h>
+#include <hairvox/volumetric/sh_rotation.h>
 
 #include <cstdint>
 #include <ostream>
+#include <span>
 #include <vector>
 
 namespace hairvox {
@@ -91,6 +96,9 @@ public:
     /// the cell, toward where the light comes from): sample/Λ in the basis.
     /// Not thread-safe for one slot.
     void deposit(std::uint32_t slot, const Vec3f& omega_i, const Rgb& sample);
+    /// The same with ω_i's basis values Y_lm(ω_i) given ((L + 1)² floats,
+    /// SphericalHarmonics::evaluate): a flight deposits into several cells.
+    void deposit(std::uint32_t slot, const float* y, const Rgb& sample);
 
     /// Ends the deposits; `kernels[t]` is fiber type t's scattering kernel
     /// (of the cache's SH order).
@@ -101,6 +109,18 @@ public:
     /// toward unit ω_o from the cached light (see above); 0 outside the
     /// cells. Needs finish().
     Rgb outgoing(const Vec3f& x, const Vec3f& u, const Vec3f& omega_o, std::size_t type) const;
+    /// outgoing() in two steps, for callers that read the cells once for
+    /// several fragments of a fiber (pipeline: at samples along the fibers).
+    /// First L̄ at x[k] in the frame of a fiber there, frames[k] (c' = C_F c
+    /// of the cells' blend; sh_rotation.h), into out[k·3(L + 1)² …] (planar
+    /// [channel][lm]; zeros outside the cells), ShFrameRotation::kLanes
+    /// points at a time across the SIMD lanes. Needs no finish().
+    void incidentInFrames(std::span<const Vec3f> x, std::span<const ShFrameRotation> frames,
+                          float* out) const;
+    /// Then the radiance toward ω_o of a fiber of type `type` whose incident
+    /// coefficients in `frame` are `c` (incidentInFrames()). Needs finish().
+    Rgb outgoingInFrame(const float* c, const ShFrameRotation& frame, const Vec3f& omega_o,
+                        std::size_t type) const;
     /// The incident radiance L̄(x, ω_i) the fibers at x receive (trilinear
     /// between the cells' expansions): for tests and plots.
     Rgb incident(const Vec3f& x, const Vec3f& omega_i) const;

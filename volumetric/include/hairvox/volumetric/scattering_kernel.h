@@ -17,8 +17,8 @@
 // values) at R outgoing s_o (rows, read linearly between), projected by a
 // fine quadrature of f_s (Gauss–Legendre panels in s, the midpoint rule over
 // the period in φ; the cross-section's twist averaged when the fiber is
-// eccentric). A fragment rotates its cell's coefficients into its own frame
-// (c' = C_F c, sh_rotation.h) and contracts:
+// eccentric). A fiber's cell coefficients are rotated into its frame
+// (c' = C_F c, sh_rotation.h) and contracted for each ω_o (applyInFrame):
 //     L_o = Σ_l [G_l0 c'_l0 + Σ_{m>0} G_lm (c'_lm cos mφ_o + c'_l,−m sin mφ_o)].
 // Moon, Walter & Marschner's rotation followed by their scattering matrix,
 // exact for the order held, whatever the angle between the fiber and its
@@ -39,6 +39,7 @@ namespace hairvox {
 class DiskCache;
 struct FiberParams;
 class MarschnerBcsdf;
+class ShFrameRotation;
 
 class ScatteringKernel {
 public:
@@ -62,6 +63,11 @@ public:
     /// radiance whose SH coefficients are `coefficients` (planar [channel][lm],
     /// 3·(L + 1)² floats).
     Rgb apply(const float* coefficients, const Vec3f& u, const Vec3f& omega_o) const;
+    /// The same from coefficients already in the fiber's frame (c' = C_F c,
+    /// `frame`.apply(); planar [channel][lm]): the contraction alone, (L + 1)²
+    /// multiply-adds a channel — for callers that rotate once for several ω_o.
+    Rgb applyInFrame(const float* fiberFrameCoefficients, const ShFrameRotation& frame,
+                     const Vec3f& omega_o) const;
 
     /// K's SH coefficients in the fiber's frame at φ_o = 0 (k'_lm = G_lm(s_o)
     /// for m ≥ 0, 0 for m < 0) into `k` (planar [channel][lm], 3·(L + 1)²
