@@ -142,7 +142,7 @@ GlobalTermStats RegionSurfaceShadow::evaluate(std::span<const GlobalTermQuery> q
     seen.assign(n, 0);
     for (std::size_t d = 0; d < directions_.size(); ++d) {
         std::fill(dirs.begin(), dirs.end(), directions_[d]);
-        surfaces_->occluded(origins, dirs, tMax, blocked);
+        surfaces_->occluded(origins, dirs, tMax, blocked, SurfaceScene::RayCoherence::Incoherent);
         for (std::size_t i = 0; i < n; ++i)
             if (!blocked[i]) {
                 lit[i] += weights_[d];
