@@ -229,7 +229,9 @@ Rgb EnvironmentMap::backdrop(const Vec3f& omega) const {
     const float x = uv.x * float(width_) - 0.5f, y = uv.y * float(height_) - 0.5f;
     const float x0 = std::floor(x), y0 = std::floor(y);
     const float fx = x - x0, fy = std::clamp(y - y0, 0.0f, 1.0f);
-    const int i0 = (int(x0) % width_ + width_) % width_, i1 = (i0 + 1) % width_;
+    // x0 ∈ [−1, width − 1] (u ∈ [0, 1)): the columns wrap without an
+    // integer division (three a lookup, the camera's 4 a pixel).
+    const int i0 = x0 < 0 ? int(x0) + width_ : int(x0), i1 = i0 + 1 == width_ ? 0 : i0 + 1;
     const int j0 = std::clamp(int(y0), 0, height_ - 1),
               j1 = std::min(std::max(int(y0) + 1, 0), height_ - 1);
     const auto at = [&](int i, int j) {

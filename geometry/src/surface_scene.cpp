@@ -88,15 +88,16 @@ SurfaceScene::SurfaceScene(std::vector<Sphere> spheres, std::vector<TriangleMesh
         const TriangleMesh& mesh = meshes_[m];
         RTCGeometry geometry = rtcNewGeometry(e.device, RTC_GEOMETRY_TYPE_TRIANGLE);
         // Embree-allocated buffers: they carry the padding its SIMD loads read.
-        auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
-            geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-            mesh.positions.size()));
-        auto* indices = static_cast<std::uint32_t*>(rtcSetNewGeometryBuffer(
-            geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(std::uint32_t),
-            mesh.triangles.size()));
+        auto* vertices = static_cast<float*>(
+            rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                    3 * sizeof(float), mesh.positions.size()));
+        auto* indices = static_cast<std::uint32_t*>(
+            rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                    3 * sizeof(std::uint32_t), mesh.triangles.size()));
         checkEmbree(e.device, "allocating a mesh");
         std::memcpy(vertices, mesh.positions.data(), mesh.positions.size() * sizeof(Vec3f));
-        std::memcpy(indices, mesh.triangles.data(), mesh.triangles.size() * 3 * sizeof(std::uint32_t));
+        std::memcpy(indices, mesh.triangles.data(),
+                    mesh.triangles.size() * 3 * sizeof(std::uint32_t));
         rtcCommitGeometry(geometry);
         rtcAttachGeometryByID(e.scene, geometry, static_cast<unsigned>(m));
         rtcReleaseGeometry(geometry);
@@ -273,7 +274,8 @@ bool SurfaceScene::occluded(const Vec3f& origin, const Vec3f& dir, float tMax) c
 }
 
 void SurfaceScene::occluded(std::span<const Vec3f> origins, std::span<const Vec3f> dirs,
-                            std::span<const float> tMax, std::span<std::uint8_t> blocked) const {
+                            std::span<const float> tMax, std::span<std::uint8_t> blocked,
+                            RayCoherence coherence) const {
     // Spheres and the bounding box per segment; the rest go to Embree together.
     struct Scratch {
         std::vector<RTCRay> rays;
@@ -296,6 +298,8 @@ void SurfaceScene::occluded(std::span<const Vec3f> origins, std::span<const Vec3
     if (rays.empty())
         return;
     RTCIntersectContext context = coherentContext();
+    if (coherence == RayCoherence::Incoherent)
+        context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
     rtcOccluded1M(embree_->scene, &context, rays.data(), static_cast<unsigned>(rays.size()),
                   sizeof(RTCRay));
     for (std::size_t k = 0; k < rays.size(); ++k)

@@ -91,7 +91,7 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
         std::vector<GlobalTerm> terms;
         FiberSamplePlan plan;                ///< the environment's samples along the fibers
         std::vector<GlobalTerm> sampleTerms; ///< at them
-        std::vector<ShadeBatch> batches;                 ///< per fiber type
+        std::vector<ShadeBatch> batches;     ///< per fiber type
         std::vector<std::vector<std::uint32_t>> members; ///< per fiber type: its points
     };
     ThreadScratch<Scratch> scratch;
@@ -152,11 +152,14 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
         const bool ofEnvironment = l >= lightCount;
         const std::shared_ptr<const LightGlobalTerm>& term =
             ofEnvironment ? environment_.terms[l - lightCount] : terms_[l];
+        // A region's terms at its samples, interpolated to each point as the
+        // batch takes it: no array of them in between (the default scene's 8
+        // regions wrote and read back 22M).
+        const bool interpolated = ofEnvironment && planned && term;
         if (term) {
             const auto evalStart = std::chrono::steady_clock::now();
-            if (ofEnvironment && planned) {
+            if (interpolated) {
                 GlobalTermStats stats = term->evaluate(plan.samples(), sampleTerms);
-                plan.interpolate(sampleTerms, terms);
                 stats.queries = points.size();
                 environmentStats += stats;
             } else {
@@ -194,7 +197,8 @@ void DualScatteringFragmentShader::shade(std::span<const ShadingPoint> points,
                 }
             }
             for (std::size_t k = 0; k < batch.size(); ++k) {
-                GlobalTerm g = terms[pointOf(t, k)];
+                GlobalTerm g =
+                    interpolated ? plan.at(sampleTerms, pointOf(t, k)) : terms[pointOf(t, k)];
                 if (volumetric)
                     g.T_s = Rgb(0.0f); // the forward-scattered light is the cache's
                 batch.setGlobalTerm(k, g);

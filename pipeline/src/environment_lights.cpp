@@ -142,7 +142,7 @@ GlobalTermStats RegionSurfaceShadow::evaluate(std::span<const GlobalTermQuery> q
     seen.assign(n, 0);
     for (std::size_t d = 0; d < directions_.size(); ++d) {
         std::fill(dirs.begin(), dirs.end(), directions_[d]);
-        surfaces_->occluded(origins, dirs, tMax, blocked);
+        surfaces_->occluded(origins, dirs, tMax, blocked, SurfaceScene::RayCoherence::Incoherent);
         for (std::size_t i = 0; i < n; ++i)
             if (!blocked[i]) {
                 lit[i] += weights_[d];
@@ -187,21 +187,16 @@ GlobalTermStats RegionSurfaceShadow::evaluate(std::span<const GlobalTermQuery> q
 }
 
 BackgroundLayer backgroundLayer(const EnvironmentMap& map, const Camera& camera) {
-    const int width = camera.width(), height = camera.height();
     BackgroundLayer layer;
-    layer.radiance = LargeBuffer<Rgb>(std::size_t(width) * std::size_t(height));
-    tbb::parallel_for(0, height, [&](int y) {
-        for (int x = 0; x < width; ++x) {
-            Rgb sum(0.0f);
-            for (int k = 0; k < 4; ++k) {
-                const Vec2f raster(float(x) + 0.25f + 0.5f * float(k & 1),
-                                   float(y) + 0.25f + 0.5f * float(k >> 1));
-                sum += map.backdrop(camera.toWorldDirection(camera.rayDirection(raster)));
-            }
-            std::construct_at(&layer.radiance[std::size_t(y) * std::size_t(width) + std::size_t(x)],
-                              0.25f * sum);
+    layer.radiance = [&map, &camera](int x, int y) {
+        Rgb sum(0.0f);
+        for (int k = 0; k < 4; ++k) {
+            const Vec2f raster(float(x) + 0.25f + 0.5f * float(k & 1),
+                               float(y) + 0.25f + 0.5f * float(k >> 1));
+            sum += map.backdrop(camera.toWorldDirection(camera.rayDirection(raster)));
         }
-    });
+        return 0.25f * sum;
+    };
     return layer;
 }
 

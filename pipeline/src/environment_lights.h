@@ -122,7 +122,8 @@ private:
 };
 
 /// The map's backdrop as the camera sees it: per pixel the mean of
-/// EnvironmentMap::backdrop() over 2 × 2 points of the pixel.
+/// EnvironmentMap::backdrop() over 2 × 2 points of the pixel, evaluated when
+/// the rasterizer asks for the pixel. `map` and `camera` must outlive it.
 BackgroundLayer backgroundLayer(const EnvironmentMap& map, const Camera& camera);
 
 } // namespace hairvox::detail

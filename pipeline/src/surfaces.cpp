@@ -20,7 +20,7 @@ namespace hairvox::detail {
 
 namespace {
 
-constexpr int kEdgeSamples = 8;          ///< per side, in a silhouette or depth-edge pixel
+constexpr int kEdgeSamples = 8; ///< per side, in a silhouette or depth-edge pixel
 constexpr int kQuadrant = kEdgeSamples / 2;
 constexpr auto kQuadrantSamples = std::size_t(kQuadrant * kQuadrant);
 constexpr float kSmoothDepthRatio = 1.02f; ///< corners this close in depth: one smooth surface
@@ -36,7 +36,7 @@ struct ViewSample {
     std::uint32_t surface; ///< kMiss where the ray met nothing
     float depth;           ///< camera-space z
     Vec3f position;
-    Vec3f normal;          ///< shading, facing the camera
+    Vec3f normal; ///< shading, facing the camera
     Vec3f geometricNormal;
 };
 
@@ -313,7 +313,7 @@ void lightSamples(const SurfaceScene& surfaces, std::span<const ShadingSample> s
             environment->terms[r]->evaluate(queries, g);
             tMax.assign(queries.size(), std::numeric_limits<float>::infinity());
             blocked.resize(queries.size()); // every element written by occluded
-            surfaces.occluded(origins, dirs, tMax, blocked);
+            surfaces.occluded(origins, dirs, tMax, blocked, SurfaceScene::RayCoherence::Incoherent);
             for (std::size_t k = 0; k < queries.size(); ++k)
                 if (!blocked[k])
                     radiance[which[k]] += float(InvPi) * albedo[samples[which[k]].view.surface] *

@@ -86,10 +86,6 @@ RasterOutput rasterize(const Groom& groom, const Camera& camera, const FragmentS
          surfaces.radiance.size() != pixels))
         throw InputError(strCat("surface layer of ", surfaces.coverage.size(), " pixels for a ",
                                 camera.width(), " x ", camera.height(), " camera"));
-    if (!background.empty() && background.radiance.size() != pixels)
-        throw InputError(strCat("background layer of ", background.radiance.size(),
-                                " pixels for a ", camera.width(), " x ", camera.height(),
-                                " camera"));
     const ThreadLimit threadLimit(settings.threads);
 
     RenderContext ctx(groom, camera, shader, settings, surfaces, background);

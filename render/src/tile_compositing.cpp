@@ -261,8 +261,14 @@ void TileRenderer::finishCoverage() {
         alpha.set(i, 0, 1.0f - st.T);
         hairAlpha.set(i, 0, st.hairWeight);
         depth.set(i, 0, st.T < 1.0f ? st.depthSum / (1.0f - st.T) : 0.0f);
-        const Rgb b = st.T * (ctx_.background.empty() ? ctx_.settings.background
-                                                      : ctx_.background.radiance[imageIndex(p)]);
+        // (A covered pixel's backdrop is not asked for: T·0 is the +0 that
+        // T·backdrop was, the backdrop being finite.)
+        const Rgb behind = ctx_.background.empty() ? ctx_.settings.background
+                           : st.T > 0
+                               ? ctx_.background.radiance(x0_ + int(p % std::uint32_t(width_)),
+                                                          y0_ + int(p / std::uint32_t(width_)))
+                               : Rgb(0.0f);
+        const Rgb b = st.T * behind;
         for (int c = 0; c < 3; ++c) {
             const auto k = std::size_t(c);
             surface.set(i, k, st.surface[c]);

@@ -89,7 +89,8 @@ constexpr std::size_t kIrradianceRow = kGlobalTermRow + detail::kGlobalTermRows;
 } // namespace
 
 void ShadeBatch::reset(std::size_t count) {
-    static_assert(kInputRows == kIrradianceRow + 3 && kOutputRows == detail::kShadeRows);
+    static_assert(kInputRows == kIrradianceRow + 3 && kOutputRows == detail::kShadeRows &&
+                  kGlobalTermFirstRow == kGlobalTermRow);
     count_ = count;
     // Whole vectors, plus one: rows a power of two apart (1024 points: 4 KiB)
     // would all map to the same L1 cache sets and evict each other.
@@ -127,12 +128,6 @@ void ShadeBatch::setIncident(const Vec3f& wi, const Rgb& E) {
         std::fill_n(&in(detail::kWiX + uc, 0), count_, wi[c]);
         std::fill_n(&in(kIrradianceRow + uc, 0), count_, E[c]);
     }
-}
-
-void ShadeBatch::setGlobalTerm(std::size_t i, const GlobalTerm& g) {
-    const auto rows = globalTermRows(g);
-    for (std::size_t r = 0; r < rows.size(); ++r)
-        in(kGlobalTermRow + r, i) = rows[r];
 }
 
 ShadeResult ShadeBatch::radiance(std::size_t i) const {

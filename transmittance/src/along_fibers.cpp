@@ -11,19 +11,6 @@ namespace hairvox {
 
 namespace {
 
-GlobalTerm lerp(float f, const GlobalTerm& a, const GlobalTerm& b) {
-    const auto mix = [f](const auto& x, const auto& y) {
-        return x + f * (y - x);
-    };
-    GlobalTerm g;
-    g.n = mix(a.n, b.n);
-    g.V = mix(a.V, b.V);
-    g.P = mix(a.P, b.P);
-    g.T_s = mix(a.T_s, b.T_s);
-    g.sigma2_f = mix(a.sigma2_f, b.sigma2_f);
-    return g;
-}
-
 class AlongFibers final : public LightGlobalTerm {
 public:
     AlongFibers(std::unique_ptr<LightGlobalTerm> inner, const Groom& groom, float spacing,
@@ -155,14 +142,6 @@ void FiberSamplePlan::plan(std::span<const GlobalTermQuery> queries, const Groom
         vertexAfter = needed_.back() == m ? q.segment : kUnknownSegment;
         vertexStrand = q.strand;
         i = end;
-    }
-}
-
-void FiberSamplePlan::interpolate(std::span<const GlobalTerm> values,
-                                  std::span<GlobalTerm> out) const {
-    for (std::size_t j = 0; j < where_.size(); ++j) {
-        const Where w = where_[j];
-        out[j] = w.f > 0 ? lerp(w.f, values[w.sample], values[w.sample + 1]) : values[w.sample];
     }
 }
 

@@ -30,8 +30,8 @@ namespace hairvox {
 
 struct SurfaceHit {
     float t = 0;
-    std::uint32_t surface = 0; ///< spheres first, then meshes
-    Vec3f normal{0.0f};        ///< unit shading normal, facing the ray's origin
+    std::uint32_t surface = 0;   ///< spheres first, then meshes
+    Vec3f normal{0.0f};          ///< unit shading normal, facing the ray's origin
     Vec3f geometricNormal{0.0f}; ///< unit, facing the ray's origin
 };
 
@@ -66,7 +66,23 @@ public:
     /// light): blocked[i] = occluded(origins[i], dirs[i], tMax[i]) (1 or 0).
     /// All four spans have the same size. Thread-safe.
     void occluded(std::span<const Vec3f> origins, std::span<const Vec3f> dirs,
-                  std::span<const float> tMax, std::span<std::uint8_t> blocked) const;
+                  std::span<const float> tMax, std::span<std::uint8_t> blocked) const {
+        occluded(origins, dirs, tMax, blocked, RayCoherence::Coherent);
+    }
+    /// Whether Embree traces a stream as packets of neighbouring rays
+    /// (Coherent: a camera's, a light's shadow rays from neighbouring
+    /// fragments) or ray by ray (Incoherent). Each ray's answer is the
+    /// intersection test of the mode chosen, which can differ between the
+    /// two for a ray grazing a triangle's edge.
+    enum class RayCoherence { Coherent, Incoherent };
+    /// occluded() for a stream traced as `coherence` says. Ray by ray
+    /// suits the environment's shadow rays (the hair's samples along many
+    /// fibers toward a region, the surfaces' points toward their region
+    /// light): Embree's packets of them cost 0.3 CPU-s more of the default
+    /// scene's 5, for the same answers there (docs/environment.md).
+    void occluded(std::span<const Vec3f> origins, std::span<const Vec3f> dirs,
+                  std::span<const float> tMax, std::span<std::uint8_t> blocked,
+                  RayCoherence coherence) const;
     /// Whether p is inside a sphere, or inside a closed mesh: the first surface
     /// met along most of three fixed directions is seen from behind.
     bool contains(const Vec3f& p) const;

@@ -56,6 +56,7 @@
 #include <hairvox/shading/marschner.h>
 
 #include <cstddef>
+#include <iterator>
 #include <vector>
 
 namespace hairvox {
@@ -77,15 +78,21 @@ public:
     /// E (facing the light); or the same at every point.
     void setIncident(std::size_t i, const Vec3f& wi, const Rgb& E);
     void setIncident(const Vec3f& wi, const Rgb& E);
-    /// The current light's global term at point i.
-    void setGlobalTerm(std::size_t i, const GlobalTerm& g);
+    /// The current light's global term at point i (inline: a store per row,
+    /// once per point and light).
+    void setGlobalTerm(std::size_t i, const GlobalTerm& g) {
+        const float rows[] = {g.V,          g.T_s.r,      g.T_s.g,     g.T_s.b,
+                              g.sigma2_f.r, g.sigma2_f.g, g.sigma2_f.b};
+        for (std::size_t r = 0; r < std::size(rows); ++r)
+            in(kGlobalTermFirstRow + r, i) = rows[r];
+    }
     /// Σ over the lights shaded so far of E·ShadeResult at point i.
     ShadeResult radiance(std::size_t i) const;
 
 private:
     friend class DualScatteringShader;
     /// Rows: ω_i, ω_o, u (9); then V, T_s, σ_f² (7); then E (3).
-    static constexpr std::size_t kInputRows = 19;
+    static constexpr std::size_t kInputRows = 19, kGlobalTermFirstRow = 9;
     static constexpr std::size_t kOutputRows = 15; ///< ShadeResult's channels
     float& in(std::size_t row, std::size_t i) { return inputs_[row * capacity_ + i]; }
 

@@ -167,7 +167,28 @@ public:
     std::span<const GlobalTermQuery> samples() const { return samples_; }
     /// out[j], the global term at query j, from the samples' values
     /// (values.size() == samples().size(), out.size() == the queries').
-    void interpolate(std::span<const GlobalTerm> values, std::span<GlobalTerm> out) const;
+    void interpolate(std::span<const GlobalTerm> values, std::span<GlobalTerm> out) const {
+        for (std::size_t j = 0; j < where_.size(); ++j)
+            out[j] = at(values, j);
+    }
+    /// The global term at query j alone (what interpolate() writes to out[j]):
+    /// for a caller that consumes each query's term once, without an array of them.
+    GlobalTerm at(std::span<const GlobalTerm> values, std::size_t j) const {
+        const Where w = where_[j];
+        if (!(w.f > 0))
+            return values[w.sample];
+        const GlobalTerm &a = values[w.sample], &b = values[w.sample + 1];
+        const auto mix = [f = w.f](const auto& x, const auto& y) {
+            return x + f * (y - x);
+        };
+        GlobalTerm g;
+        g.n = mix(a.n, b.n);
+        g.V = mix(a.V, b.V);
+        g.P = mix(a.P, b.P);
+        g.T_s = mix(a.T_s, b.T_s);
+        g.sigma2_f = mix(a.sigma2_f, b.sigma2_f);
+        return g;
+    }
 
     /// How a query is read: the sample at or below it (an index into
     /// samples()) and the fraction toward the next one, a sample of the same
