@@ -73,6 +73,13 @@ struct PipelineOptions {
     std::filesystem::path tableCacheDir; ///< empty: defaultTableCacheDir()
     GridOptions grid; ///< settings of the grid and approx modes (measured defaults)
     EnvironmentOptions environment; ///< of an environment light, dual scattering
+    /// The volumetric integrator's samples along the fibers, in its cache's
+    /// cells (docs/DESIGN.md §9): its cells are read, and rotated into the
+    /// fiber's frame, there, and each fragment interpolates between two
+    /// samples. Measured on key_back.json at 512² against reading every
+    /// fragment: `multiple` moves 0.5% / 1.7% / 4.9% rel L1 per pixel (bias
+    /// ≤ 0.02%) at 1/4, 1/2, 1. 0: every fragment read where it is. [0, 2].
+    float multipleSampleSpacing = 0.5f;
     /// Path tracing: add samples to the scene's own EXR output when it exists
     /// (InputError if it was rendered from another scene or seed).
     bool continuePathTrace = false;
