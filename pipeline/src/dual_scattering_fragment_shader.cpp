@@ -3,9 +3,10 @@
 #include <hairvox/core/math.h>
 #include <hairvox/core/thread_scratch.h>
 #include <hairvox/strands/groom.h>
-#include <hairvox/volumetric/spherical_harmonics.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 
 namespace hairvox::detail {
 
