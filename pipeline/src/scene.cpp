@@ -670,6 +670,8 @@ Scene parseScene(const nlohmann::json& document, const std::string& sourceName,
             set("sh_order", volumetric, [&](const JsonValue& x) {
                 vol.cache.shOrder = static_cast<int>(x.integer(1, SphericalHarmonics::kMaxOrder));
             });
+            set("denoise", volumetric,
+                [&](const JsonValue& x) { vol.cache.denoise = x.boolean(); });
             set("transport", volumetric,
                 [&](const JsonValue& x) { vol.transport = x.oneOf(kVolumetricTransportNames); });
             in.finish();

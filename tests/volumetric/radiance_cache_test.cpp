@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iostream>
 #include <numeric>
 #include <utility>
 
@@ -62,6 +63,80 @@ TEST(RadianceCache, DepositsProjectTheIncidentField) {
         const Rgb got = cache.incident(x, w);
         EXPECT_NEAR(got.r, field(w), 0.05f) << "direction " << w;
     }
+}
+
+/// The RMS over directions of a cell's read field against `field`, and its
+/// mean (midpoints in z = cos and φ: exact for the orders a cache holds).
+template <typename F>
+std::pair<double, double> readError(const RadianceCache& cache, const Vec3f& x, F&& field) {
+    double squares = 0, mean = 0;
+    const int n = 64;
+    for (int a = 0; a < n; ++a)
+        for (int b = 0; b < n; ++b) {
+            const float z = -1.0f + (float(a) + 0.5f) * 2.0f / float(n);
+            const float phi = (float(b) + 0.5f) * float(TwoPi) / float(n);
+            const float r = std::sqrt(1.0f - z * z);
+            const Vec3f w(r * std::cos(phi), r * std::sin(phi), z);
+            const double got = double(cache.incident(x, w).g);
+            squares += (got - double(field(w))) * (got - double(field(w)));
+            mean += got;
+        }
+    return {std::sqrt(squares / (n * n)), mean / (n * n)};
+}
+
+TEST(RadianceCache, ReadsShrinkTheBandsTheFlightsCouldNotResolve) {
+    test::Slab slab;
+    slab.fibers = 2000;
+    const FiberGrid grid = test::splatSlab(slab, 0.002);
+    // Two caches of one cell's deposits, read with and without the shrinkage.
+    RadianceCacheSettings denoised, raw;
+    raw.denoise = false;
+    RadianceCache a(grid, denoised, 1ull << 30), b(grid, raw, 1ull << 30);
+    const auto slot = std::uint32_t(a.slotAt(Vec3f(0.0f, 0.005f, 0.0f)));
+    const Vec3f x = a.cellCentre(slot);
+    const float lambda = a.fiberLength(slot);
+    const auto deposit = [&](const Vec3f& w, float value) {
+        a.deposit(slot, w, Rgb(value * lambda));
+        b.deposit(slot, w, Rgb(value * lambda));
+    };
+    // Uniform radiance 1 from 40 random directions: band 0 is the field,
+    // every other band the flights' noise.
+    Pcg32 rng(3);
+    const int few = 40;
+    for (int k = 0; k < few; ++k)
+        deposit(uniformSphere(rng.uniformFloat(), rng.uniformFloat()), float(4.0 * Pi) / few);
+    const auto uniform = [](const Vec3f&) { return 1.0f; };
+    const auto [noisyRaw, meanRaw] = readError(b, x, uniform);
+    const auto [noisyDenoised, meanDenoised] = readError(a, x, uniform);
+    std::cout << "uniform light from " << few << " flights: RMS " << noisyRaw << " raw, "
+              << noisyDenoised << " denoised; means " << meanRaw << ", " << meanDenoised << "\n";
+    // Measured: RMS 1.50 raw, 0.41 denoised; means 1.0014 and 1.0002 (band
+    // 0 is 1 in both: the rest is the quadrature's, of the noise above it).
+    EXPECT_LT(noisyDenoised, 0.5 * noisyRaw);
+    EXPECT_NEAR(meanDenoised, 1.0, 3e-3);
+    EXPECT_NEAR(meanRaw, 1.0, 3e-3);
+
+    // A field the flights resolve — 200,000 of them, from a cone of 25° about
+    // +z over the uniform — is read as it was deposited.
+    RadianceCache c(grid, denoised, 1ull << 30), d(grid, raw, 1ull << 30);
+    const Vec3f axis(0, 0, 1);
+    const float cosCone = std::cos(float(radians(25.0)));
+    const auto cone = [&](const Vec3f& w) {
+        return 1.0f + (glm::dot(w, axis) > cosCone ? 10.0f : 0.0f);
+    };
+    const int many = 200000;
+    for (int k = 0; k < many; ++k) {
+        const Vec3f w = uniformSphere(rng.uniformFloat(), rng.uniformFloat());
+        c.deposit(slot, w, Rgb(cone(w) * float(4.0 * Pi) / float(many) * lambda));
+        d.deposit(slot, w, Rgb(cone(w) * float(4.0 * Pi) / float(many) * lambda));
+    }
+    const Rgb peakDenoised = c.incident(x, axis), peakRaw = d.incident(x, axis);
+    std::cout << "a cone of 25 degrees from " << many << " flights, toward its axis: "
+              << peakRaw.g << " raw, " << peakDenoised.g << " denoised\n";
+    // Measured: 14.85 raw, 14.81 denoised (order 8's ringing of the cone's
+    // edge in both).
+    EXPECT_NEAR(peakDenoised.g, peakRaw.g, 0.02f * peakRaw.g);
+    EXPECT_GT(peakRaw.g, 5.0f);
 }
 
 TEST(RadianceCache, UniformIncidentLightLeavesAsTheFibersAlbedo) {

@@ -336,7 +336,7 @@ void VolumetricSettings::validate() const {
 
 void VolumetricSettings::hashInto(Hasher& h) const {
     h.value(paths).value(pathsPerCell).value(cache.shOrder);
-    h.value(cache.cellVoxels).value(maxDepth).value(rouletteDepth).value(seed).value(transport);
+    h.value(cache.cellVoxels).value(cache.denoise).value(maxDepth).value(rouletteDepth).value(seed).value(transport);
 }
 
 std::ostream& operator<<(std::ostream& os, const VolumetricSettings& s) {

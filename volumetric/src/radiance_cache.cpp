@@ -48,7 +48,7 @@ void RadianceCacheSettings::validate() const {
 
 std::ostream& operator<<(std::ostream& os, const RadianceCacheSettings& s) {
     return os << "RadianceCacheSettings(shOrder=" << s.shOrder << ", cellVoxels=" << s.cellVoxels
-              << ")";
+              << ", denoise=" << s.denoise << ")";
 }
 
 std::uint64_t RadianceCache::estimateBytes(const FiberGrid& grid,
@@ -61,7 +61,7 @@ std::uint64_t RadianceCache::estimateBytes(const FiberGrid& grid,
     // Occupied cells at most: one per active voxel, or the whole box.
     const std::uint64_t cells = std::min<std::uint64_t>(grid.activeVoxelCount(), boxCells(dims));
     const std::uint64_t perCell =
-        4 * 3 * std::uint64_t(settings.coefficients()) + sizeof(glm::ivec3) + sizeof(float);
+        4 * 3 * (std::uint64_t(settings.coefficients()) + 1) + sizeof(glm::ivec3) + sizeof(float);
     return boxCells(dims) * 4 + cells * perCell;
 }
 
@@ -107,6 +107,7 @@ RadianceCache::RadianceCache(const FiberGrid& grid, const RadianceCacheSettings&
         fiberLength_[s] = float(sumL[s] * voxelVolume);
 
     coefficients_.assign(cells_.size() * floatsPerCell(), 0.0f);
+    secondMoment_.assign(cells_.size() * 3, 0.0f);
 }
 
 Bounds3f RadianceCache::bounds() const {
@@ -122,7 +123,8 @@ Bounds3f RadianceCache::bounds() const {
 std::uint64_t RadianceCache::memoryBytes() const {
     std::uint64_t bytes = grid_.memoryBytes() + cells_.capacity() * sizeof(glm::ivec3) +
                           fiberLength_.capacity() * sizeof(float) +
-                          coefficients_.size() * sizeof(float);
+                          coefficients_.size() * sizeof(float) +
+                          secondMoment_.capacity() * sizeof(float);
     return bytes;
 }
 
@@ -142,6 +144,7 @@ void RadianceCache::deposit(std::uint32_t slot, const float* y, const Rgb& sampl
     const float inv = 1.0f / fiberLength_[slot];
     for (int ch = 0; ch < 3; ++ch) {
         const float w = sample[ch] * inv;
+        secondMoment_[std::size_t(slot) * 3 + std::size_t(ch)] += w * w;
         float* cc = c + ch * nc;
         for (int m = 0; m < nc; ++m)
             cc[m] += w * y[m];
@@ -159,15 +162,35 @@ void RadianceCache::finish(std::vector<ScatteringKernel> kernels) {
 bool RadianceCache::blend(const Vec3f& x, float* out) const {
     const std::size_t n = floatsPerCell();
     std::fill(out, out + n, 0.0f);
+    Rgb moment(0.0f); // Σ_i w_i²·Σ_f w_f² of the cells blended
     const float weights = grid_.forEachAround(x, [&](std::size_t slot, float w) {
         const float* c = coefficients_.data() + slot * n;
         for (std::size_t i = 0; i < n; ++i)
             out[i] += w * c[i];
+        for (std::size_t ch = 0; ch < 3; ++ch)
+            moment[int(ch)] += w * w * secondMoment_[slot * 3 + ch];
     });
     if (!(weights > 0))
         return false;
     for (std::size_t i = 0; i < n; ++i)
         out[i] /= weights;
+    if (settings_.denoise) {
+        // James–Stein per band (see the header): N_l = (2l + 1)/4π·moment/W².
+        const int nc = settings_.coefficients();
+        const float unitNoise = float(1.0 / (4.0 * Pi)) / (weights * weights);
+        for (int ch = 0; ch < 3; ++ch) {
+            float* c = out + ch * nc;
+            for (int l = 1; l <= settings_.shOrder; ++l) {
+                float energy = 0;
+                for (int i = l * l; i < (l + 1) * (l + 1); ++i)
+                    energy += c[i] * c[i];
+                const float noise = float(2 * l + 1) * unitNoise * moment[ch];
+                const float gain = energy > noise ? 1.0f - noise / energy : 0.0f;
+                for (int i = l * l; i < (l + 1) * (l + 1); ++i)
+                    c[i] *= gain;
+            }
+        }
+    }
     return true;
 }
 

@@ -31,6 +31,24 @@
 // half beyond the hair's surface, would otherwise mix in the radiance of
 // space no fiber sees.
 //
+// Noise. A cell's coefficients are sums over the flights that crossed it,
+// c_lm = Σ_f w_f·Y_lm(ω_f) (w_f = sample/Λ), so each is noisy, and by the
+// addition theorem Σ_m Y_lm(ω)² = (2l + 1)/4π the variance of band l is
+// estimated by N_l = (2l + 1)/4π·Σ_f w_f² (the flights' counts Poisson), one
+// second moment per cell and channel. A read shrinks each band l ≥ 1 of the
+// blended coefficients toward zero by the positive-part James–Stein gain
+// g_l = max(0, 1 − N_l/E_l), E_l = Σ_m ĉ_lm², with N_l of the blend
+// (Σ_i a_i² N_l,i for blend weights a_i): it keeps a band where its energy
+// stands above the noise and drops it where the flights could not resolve
+// it. Band 0, the mean radiance, is kept as estimated. The hair's radiance
+// against the path tracer (4×4 blocks, its noise removed; seeds 1–3), without
+// and with (`RadianceCacheSettings::denoise`): the default look at 256²
+// 0.058 / 0.064 / 0.058 → 0.055 / 0.061 / 0.055, the curly close-up at 80×60
+// 0.085 / 0.082 / 0.084 → 0.081 / 0.078 / 0.079; the default look with 4×
+// the paths, seed 1, 0.050 → 0.049. (Shrinking each cell's own bands
+// instead, before the blend, needs its noise scaled by the blend's
+// Σ a_i² ≈ (2/3)³ to do as well.)
+//
 // Outgoing radiance. outgoing() blends the coefficients of the 8 cells
 // around x trilinearly (cells without fibers left out and the weights
 // renormalised) and applies the fragment's own fiber type's scattering
@@ -60,6 +78,7 @@ struct FiberGrid;
 struct RadianceCacheSettings {
     int shOrder = 8;    ///< L: SH orders held, [1, 8]
     int cellVoxels = 2; ///< m: fiber-grid voxels per cell side, [1, 16]
+    bool denoise = true; ///< reads shrink each band by its noise (see above)
 
     int coefficients() const { return (shOrder + 1) * (shOrder + 1); }
 
@@ -135,7 +154,8 @@ public:
 private:
     std::size_t floatsPerCell() const { return 3 * std::size_t(settings_.coefficients()); }
     /// The coefficients blended trilinearly over the cells around x into
-    /// `out` (floatsPerCell() floats); false where no cell is.
+    /// `out` (floatsPerCell() floats), each band shrunk by its noise where
+    /// settings().denoise; false where no cell is.
     bool blend(const Vec3f& x, float* out) const;
 
     RadianceCacheSettings settings_;
@@ -144,6 +164,8 @@ private:
     std::vector<float> fiberLength_; ///< per slot: Λ
     /// Per slot [channel][lm]: L̄'s SH coefficients.
     LargeVector<float> coefficients_;
+    /// Per slot and channel: Σ_f w_f², the deposits' second moment (see above).
+    std::vector<float> secondMoment_;
     std::vector<ScatteringKernel> kernels_; ///< per fiber type, after finish()
     bool finished_ = false;
 };
