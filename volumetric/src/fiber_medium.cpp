@@ -22,7 +22,6 @@ constexpr float kQuarterPi = float(Pi / 4.0);
 
 FiberMedium::FiberMedium(const FiberGrid& grid)
     : grid_(&grid)
-    , density_(grid.density.data())
     , h_(float(grid.info.voxelSize))
     , kD_(grid.info.fiberScale.ribbonWidth())
     , types_(grid.fiberTypeCount()) {
@@ -30,6 +29,13 @@ FiberMedium::FiberMedium(const FiberGrid& grid)
         throw std::invalid_argument("FiberMedium: the grid has no voxel size");
     if (grid.blocks.empty())
         return;
+    voxels_.resize(grid.density.size());
+    for (std::size_t v = 0; v < voxels_.size(); ++v) {
+        VoxelMedium& m = voxels_[v];
+        m.o = Vec3f(grid.orientation[v].x(), grid.orientation[v].y(), grid.orientation[v].z());
+        m.isotropic = (1.0f - std::min(1.0f, glm::length(m.o))) * kQuarterPi;
+        m.lambda = grid.density[v];
+    }
     glm::ivec3 lo(std::numeric_limits<int>::max()), hi(std::numeric_limits<int>::min());
     for (const FiberBlock& b : grid.blocks) {
         const glm::ivec3 c(b.origin.x() / kBlockDim, b.origin.y() / kBlockDim,
@@ -105,25 +111,26 @@ std::int64_t FiberMedium::voxelAt(const Vec3f& q) const {
     return block < 0 ? -1 : voxelIn(block, v);
 }
 
-float FiberMedium::meanCosTheta(std::size_t v, const Vec3f& omega) const {
-    // c·cos θ(ω, o/c) = |ω × o|, so the blend needs no normalisation.
-    const Vec3f o(grid_->orientation[v].x(), grid_->orientation[v].y(), grid_->orientation[v].z());
-    const float c = std::min(1.0f, glm::length(o));
-    return glm::length(glm::cross(omega, o)) + (1.0f - c) * kQuarterPi;
+std::uint64_t FiberMedium::memoryBytes() const {
+    return voxels_.capacity() * sizeof(VoxelMedium) + blockIndex_.capacity() * sizeof(std::int32_t) +
+           prefix_.capacity() * sizeof(prefix_[0]);
 }
 
 float FiberMedium::extinction(const Vec3f& x, const Vec3f& omega) const {
     const std::int64_t v = voxelAt(x / h_ + 0.5f);
-    return v < 0 ? 0.0f : kD_ * grid_->density[std::size_t(v)] * meanCosTheta(std::size_t(v), omega);
+    if (v < 0)
+        return 0.0f;
+    const VoxelMedium& m = voxels_[std::size_t(v)];
+    return kD_ * m.lambda * meanCosTheta(m, omega);
 }
 
 void FiberMedium::sampleFiber(std::size_t v, const Vec3f& omega, Pcg32& rng,
                               MediumCollision& out) const {
-    const Vec3f o(grid_->orientation[v].x(), grid_->orientation[v].y(), grid_->orientation[v].z());
+    const VoxelMedium& m = voxels_[v];
+    const Vec3f& o = m.o;
     const float len = glm::length(o);
-    const float c = std::min(1.0f, len);
     const float coherent = glm::length(glm::cross(omega, o));
-    const float isotropic = (1.0f - c) * kQuarterPi;
+    const float isotropic = m.isotropic;
     if (len > 0 && rng.uniformFloat() * (coherent + isotropic) < coherent) {
         out.tangent = o / len;
     } else {

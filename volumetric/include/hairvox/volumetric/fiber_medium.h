@@ -128,6 +128,8 @@ public:
     float voxelSize() const { return h_; }
     const FiberGrid& grid() const { return *grid_; }
     std::size_t fiberTypeCount() const { return types_; }
+    /// Bytes the medium holds besides the grid (its voxel records and block index).
+    std::uint64_t memoryBytes() const;
 
 private:
     /// The block at block coordinates b, or -1.
@@ -143,13 +145,24 @@ private:
     /// segment crosses, in order, while visit returns true.
     template <typename Visit>
     void walkBlocks(const Vec3f& origin, const Vec3f& dir, float tEnd, Visit&& visit) const;
+    /// What a flight reads of a voxel, packed from the grid's arrays (its
+    /// λ and o live apart there): one 32-byte record, one cache line.
+    struct alignas(32) VoxelMedium {
+        Vec3f o{0.0f};       ///< E[u], |o| = c ≤ 1 (not normalised)
+        float isotropic = 0; ///< (1 − c)·π/4: the isotropic part's E[cos θ]
+        float lambda = 0;    ///< λ, fiber length per volume
+    };
+
     /// The fiber tangent and type met by a ray of direction ω in voxel `v`.
     void sampleFiber(std::size_t v, const Vec3f& omega, Pcg32& rng, MediumCollision& out) const;
-    /// E_v[cos θ] of voxel v toward ω.
-    float meanCosTheta(std::size_t v, const Vec3f& omega) const;
+    /// E_v[cos θ] of voxel v toward ω: c·cos θ(ω, o/c) = |ω × o|, so the
+    /// blend needs no normalisation.
+    static float meanCosTheta(const VoxelMedium& m, const Vec3f& omega) {
+        return glm::length(glm::cross(omega, m.o)) + m.isotropic;
+    }
 
     const FiberGrid* grid_;
-    const float* density_; ///< the grid's λ per voxel value
+    std::vector<VoxelMedium> voxels_; ///< per voxel value
     float h_ = 1, kD_ = 0;
     std::size_t types_ = 1;
     Bounds3f bounds_;
@@ -226,11 +239,12 @@ FiberMedium::sampleCollision(const Vec3f& origin, const Vec3f& dir, float tMax, 
     float tau = -std::log1p(-rng.uniformFloat()); // the optical depth left to the collision
     std::optional<MediumCollision> hit;
     walkVoxels(origin, dir, tMax, [&](std::size_t v, const glm::ivec3& ijk, float t0, float t1) {
-        const float lambda = density_[v];
+        const VoxelMedium& m = voxels_[v];
+        const float lambda = m.lambda;
         const float lambdaOwn =
             own && t0 < ownReach && nearOwnFiber(*own, ijk) ? ownDensity(*own, ijk) : 0.0f;
         const float sigma =
-            std::max(0.0f, kD_ * (lambda * meanCosTheta(v, dir) - ownCross * lambdaOwn));
+            std::max(0.0f, kD_ * (lambda * meanCosTheta(m, dir) - ownCross * lambdaOwn));
         const float depth = sigma * (t1 - t0);
         const float lambdaMet = std::max(0.0f, lambda - lambdaOwn);
         if (!(sigma > 0) || depth < tau) {

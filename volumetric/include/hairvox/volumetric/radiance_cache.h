@@ -88,9 +88,6 @@ public:
     const CellGrid& cells() const { return grid_; }
     std::uint64_t memoryBytes() const;
 
-    /// The slot of the cell holding voxel v (index space), or -1.
-    std::int64_t slotOfVoxel(const glm::ivec3& v) const;
-
     /// Adds to the cell's incident radiance a sample of Λ·L̄ (radiance ×
     /// solid angle × fiber length) arriving from unit ω_i (pointing away from
     /// the cell, toward where the light comes from): sample/Λ in the basis.
