@@ -16,7 +16,6 @@ namespace hairvox {
 namespace {
 
 constexpr int kBlockDim = FiberBlock::kDim; // 8
-constexpr float kQuarterPi = float(Pi / 4.0);
 
 } // namespace
 
@@ -33,7 +32,6 @@ FiberMedium::FiberMedium(const FiberGrid& grid)
     for (std::size_t v = 0; v < voxels_.size(); ++v) {
         VoxelMedium& m = voxels_[v];
         m.o = Vec3f(grid.orientation[v].x(), grid.orientation[v].y(), grid.orientation[v].z());
-        m.isotropic = (1.0f - std::min(1.0f, glm::length(m.o))) * kQuarterPi;
         m.lambda = grid.density[v];
     }
     glm::ivec3 lo(std::numeric_limits<int>::max()), hi(std::numeric_limits<int>::min());
@@ -126,11 +124,11 @@ float FiberMedium::extinction(const Vec3f& x, const Vec3f& omega) const {
 
 void FiberMedium::sampleFiber(std::size_t v, const Vec3f& omega, Pcg32& rng,
                               MediumCollision& out) const {
-    const VoxelMedium& m = voxels_[v];
-    const Vec3f& o = m.o;
+    const Vec3f& o = voxels_[v].o;
     const float len = glm::length(o);
+    const float c = std::min(1.0f, len);
     const float coherent = glm::length(glm::cross(omega, o));
-    const float isotropic = m.isotropic;
+    const float isotropic = (1.0f - c) * kQuarterPi;
     if (len > 0 && rng.uniformFloat() * (coherent + isotropic) < coherent) {
         out.tangent = o / len;
     } else {
