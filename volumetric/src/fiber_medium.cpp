@@ -54,10 +54,13 @@ FiberMedium::FiberMedium(const FiberGrid& grid)
                                 " blocks of 8 voxels: too sparse a groom for the volumetric "
                                 "integrator; raise the voxel size"));
     blockIndex_.assign(cells, -1);
-    prefix_.resize(grid.blocks.size());
+    blocks_.resize(grid.blocks.size());
     using Word = openvdb::Index64;
     for (std::size_t b = 0; b < grid.blocks.size(); ++b) {
         const FiberBlock& block = grid.blocks[b];
+        MediumBlock& mb = blocks_[b];
+        mb.origin = glm::ivec3(block.origin.x(), block.origin.y(), block.origin.z());
+        mb.first = block.first;
         const glm::ivec3 c = glm::ivec3(block.origin.x(), block.origin.y(), block.origin.z()) /
                                  kBlockDim -
                              blockMin_;
@@ -66,41 +69,15 @@ FiberMedium::FiberMedium(const FiberGrid& grid)
                     std::size_t(c.z)] = static_cast<std::int32_t>(b);
         std::uint16_t count = 0;
         for (int w = 0; w < 8; ++w) {
-            prefix_[b][std::size_t(w)] = count;
-            count = static_cast<std::uint16_t>(
-                count + openvdb::util::CountOn(block.active.getWord<Word>(openvdb::Index(w))));
+            const Word word = block.active.getWord<Word>(openvdb::Index(w));
+            mb.words[std::size_t(w)] = word;
+            mb.prefix[std::size_t(w)] = count;
+            count = static_cast<std::uint16_t>(count + openvdb::util::CountOn(word));
         }
         const Vec3f lo3 = (Vec3f(block.origin.x(), block.origin.y(), block.origin.z()) - 0.5f) * h_;
         bounds_.extend(lo3);
         bounds_.extend(lo3 + float(kBlockDim) * h_);
     }
-}
-
-std::int32_t FiberMedium::blockAt(const glm::ivec3& c) const {
-    const glm::ivec3 b = c - blockMin_;
-    if (b.x < 0 || b.y < 0 || b.z < 0 || b.x >= blockDims_.x || b.y >= blockDims_.y ||
-        b.z >= blockDims_.z)
-        return -1;
-    return blockIndex_[(std::size_t(b.x) * std::size_t(blockDims_.y) + std::size_t(b.y)) *
-                           std::size_t(blockDims_.z) +
-                       std::size_t(b.z)];
-}
-
-glm::ivec3 FiberMedium::blockOrigin(std::int32_t block) const {
-    const openvdb::Coord& o = grid_->blocks[std::size_t(block)].origin;
-    return {o.x(), o.y(), o.z()};
-}
-
-std::int64_t FiberMedium::voxelIn(std::int32_t block, const glm::ivec3& v) const {
-    const FiberBlock& fb = grid_->blocks[std::size_t(block)];
-    const auto offset = static_cast<openvdb::Index>(((v.x & 7) << 6) | ((v.y & 7) << 3) | (v.z & 7));
-    using Word = openvdb::Index64;
-    const Word word = fb.active.getWord<Word>(offset >> 6);
-    const Word bit = Word(1) << (offset & 63);
-    if (!(word & bit))
-        return -1;
-    return std::int64_t(fb.first) + prefix_[std::size_t(block)][offset >> 6] +
-           std::popcount(word & (bit - 1));
 }
 
 std::int64_t FiberMedium::voxelAt(const Vec3f& q) const {
@@ -110,8 +87,8 @@ std::int64_t FiberMedium::voxelAt(const Vec3f& q) const {
 }
 
 std::uint64_t FiberMedium::memoryBytes() const {
-    return voxels_.capacity() * sizeof(VoxelMedium) + blockIndex_.capacity() * sizeof(std::int32_t) +
-           prefix_.capacity() * sizeof(prefix_[0]);
+    return voxels_.capacity() * sizeof(VoxelMedium) +
+           blockIndex_.capacity() * sizeof(std::int32_t) + blocks_.capacity() * sizeof(MediumBlock);
 }
 
 float FiberMedium::extinction(const Vec3f& x, const Vec3f& omega) const {

@@ -55,6 +55,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <optional>
@@ -133,12 +134,37 @@ public:
     std::uint64_t memoryBytes() const;
 
 private:
+    /// A block of 8³ voxels as the walk reads it (the grid's FiberBlock and
+    /// its mask words' running counts, kept here so the lookups inline).
+    struct MediumBlock {
+        std::array<std::uint64_t, 8> words{};  ///< active voxels by offset x·64 + y·8 + z
+        std::array<std::uint16_t, 8> prefix{}; ///< active voxels before each word
+        glm::ivec3 origin{0};                  ///< its first voxel (index space)
+        std::uint32_t first = 0;               ///< value index of its first active voxel
+    };
+
     /// The block at block coordinates b, or -1.
-    std::int32_t blockAt(const glm::ivec3& b) const;
+    std::int32_t blockAt(const glm::ivec3& c) const {
+        const glm::ivec3 b = c - blockMin_;
+        if (b.x < 0 || b.y < 0 || b.z < 0 || b.x >= blockDims_.x || b.y >= blockDims_.y ||
+            b.z >= blockDims_.z)
+            return -1;
+        return blockIndex_[(std::size_t(b.x) * std::size_t(blockDims_.y) + std::size_t(b.y)) *
+                               std::size_t(blockDims_.z) +
+                           std::size_t(b.z)];
+    }
     /// Index-space coordinates of a block's first voxel.
-    glm::ivec3 blockOrigin(std::int32_t block) const;
+    glm::ivec3 blockOrigin(std::int32_t block) const { return blocks_[std::size_t(block)].origin; }
     /// The value index of voxel v (index space) in block `block`, or -1.
-    std::int64_t voxelIn(std::int32_t block, const glm::ivec3& v) const;
+    std::int64_t voxelIn(std::int32_t block, const glm::ivec3& v) const {
+        const MediumBlock& b = blocks_[std::size_t(block)];
+        const auto offset = static_cast<unsigned>(((v.x & 7) << 6) | ((v.y & 7) << 3) | (v.z & 7));
+        const std::uint64_t word = b.words[offset >> 6];
+        const std::uint64_t bit = std::uint64_t(1) << (offset & 63);
+        if (!(word & bit))
+            return -1;
+        return std::int64_t(b.first) + b.prefix[offset >> 6] + std::popcount(word & (bit - 1));
+    }
     /// The value index of the voxel whose box holds x (shifted index space
     /// q = x/h + ½), or -1.
     std::int64_t voxelAt(const Vec3f& q) const;
@@ -172,10 +198,10 @@ private:
     std::size_t types_ = 1;
     Bounds3f bounds_;
     /// Blocks in a dense array over the box of block coordinates
-    /// [blockMin_, blockMin_ + blockDims_): index into grid_->blocks, or -1.
+    /// [blockMin_, blockMin_ + blockDims_): index into blocks_, or -1.
     glm::ivec3 blockMin_{0}, blockDims_{0};
     std::vector<std::int32_t> blockIndex_;
-    std::vector<std::array<std::uint16_t, 8>> prefix_; ///< per block: active voxels before each mask word
+    std::vector<MediumBlock> blocks_; ///< per grid block, in the grid's order
 };
 
 std::ostream& operator<<(std::ostream& os, const MediumCollision& c);
