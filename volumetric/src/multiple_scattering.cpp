@@ -453,6 +453,14 @@ MultipleScatteringSolution solveMultipleScattering(const VolumetricScene& scene,
                 const ChunkRecord& r = records[k];
                 for (std::uint32_t i = r.bucketStart[b]; i < r.bucketStart[b + 1]; ++i) {
                     const Crossing& x = r.crossings[i];
+                    // The next crossing's cell and basis on their way while this one adds.
+                    if (i + 1 < r.bucketStart[b + 1]) {
+                        const Crossing& next = r.crossings[i + 1];
+                        cache.prefetch(next.slot);
+                        const float* y = r.basis.data() + std::size_t(next.flight) * nc;
+                        for (std::size_t j = 0; j < nc; j += 16)
+                            __builtin_prefetch(y + j);
+                    }
                     cache.deposit(x.slot, r.basis.data() + std::size_t(x.flight) * nc,
                                   r.flights[x.flight].power * x.weight);
                 }

@@ -37,7 +37,8 @@ struct SphericalHarmonics {
     /// Y_lm(ω) for l ≤ order into y[index(l, m)] (unit ω).
     static void evaluate(const Vec3f& omega, int order, float* y) {
         // kMaxOrder (the cache's default) with its loops unrolled at compile
-        // time: the same operations, a quarter of the instructions.
+        // time: the same operations, a third of the instructions (callgrind:
+        // a flight's basis and record ~1,800 → ~600).
         if (order == kMaxOrder)
             evaluateTo(omega, std::integral_constant<int, kMaxOrder>{}, y);
         else
