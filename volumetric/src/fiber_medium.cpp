@@ -7,7 +7,6 @@
 #include <hairvox/voxelize/fiber_grid.h>
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <limits>
 
