@@ -423,15 +423,20 @@ namespace {
 struct TruncatedLobe {
     double alpha, beta, zLo, zHi, mass;
     bool upper; ///< the interval lies above the mean: use Q(z) = 1 − Φ(z)
+    double atLo; ///< Q(zLo) if upper, else Φ(zLo): where quantile() starts
 
     TruncatedLobe(double alpha_, double beta_, double lo, double hi)
-        : alpha(alpha_), beta(beta_), zLo((lo - alpha_) / beta_), zHi((hi - alpha_) / beta_),
-          upper(zLo > 0) {
-        mass = upper ? normalTail(zLo) - normalTail(zHi) : normalCdf(zHi) - normalCdf(zLo);
+        : alpha(alpha_)
+        , beta(beta_)
+        , zLo((lo - alpha_) / beta_)
+        , zHi((hi - alpha_) / beta_)
+        , upper(zLo > 0)
+        , atLo(upper ? normalTail(zLo) : normalCdf(zLo)) {
+        mass = upper ? atLo - normalTail(zHi) : normalCdf(zHi) - atLo;
     }
     double quantile(double u) const {
-        const double z = upper ? -inverseNormalCdf(normalTail(zLo) - u * mass)
-                               : inverseNormalCdf(normalCdf(zLo) + u * mass);
+        const double z =
+            upper ? -inverseNormalCdf(atLo - u * mass) : inverseNormalCdf(atLo + u * mass);
         return alpha + beta * std::clamp(z, zLo, zHi);
     }
 };

@@ -7,7 +7,6 @@
 #include <hairvox/voxelize/fiber_grid.h>
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <limits>
 
@@ -16,13 +15,11 @@ namespace hairvox {
 namespace {
 
 constexpr int kBlockDim = FiberBlock::kDim; // 8
-constexpr float kQuarterPi = float(Pi / 4.0);
 
 } // namespace
 
 FiberMedium::FiberMedium(const FiberGrid& grid)
     : grid_(&grid)
-    , density_(grid.density.data())
     , h_(float(grid.info.voxelSize))
     , kD_(grid.info.fiberScale.ribbonWidth())
     , types_(grid.fiberTypeCount()) {
@@ -30,6 +27,12 @@ FiberMedium::FiberMedium(const FiberGrid& grid)
         throw std::invalid_argument("FiberMedium: the grid has no voxel size");
     if (grid.blocks.empty())
         return;
+    voxels_.resize(grid.density.size());
+    for (std::size_t v = 0; v < voxels_.size(); ++v) {
+        VoxelMedium& m = voxels_[v];
+        m.o = Vec3f(grid.orientation[v].x(), grid.orientation[v].y(), grid.orientation[v].z());
+        m.lambda = grid.density[v];
+    }
     glm::ivec3 lo(std::numeric_limits<int>::max()), hi(std::numeric_limits<int>::min());
     for (const FiberBlock& b : grid.blocks) {
         const glm::ivec3 c(b.origin.x() / kBlockDim, b.origin.y() / kBlockDim,
@@ -50,10 +53,13 @@ FiberMedium::FiberMedium(const FiberGrid& grid)
                                 " blocks of 8 voxels: too sparse a groom for the volumetric "
                                 "integrator; raise the voxel size"));
     blockIndex_.assign(cells, -1);
-    prefix_.resize(grid.blocks.size());
+    blocks_.resize(grid.blocks.size());
     using Word = openvdb::Index64;
     for (std::size_t b = 0; b < grid.blocks.size(); ++b) {
         const FiberBlock& block = grid.blocks[b];
+        MediumBlock& mb = blocks_[b];
+        mb.origin = glm::ivec3(block.origin.x(), block.origin.y(), block.origin.z());
+        mb.first = block.first;
         const glm::ivec3 c = glm::ivec3(block.origin.x(), block.origin.y(), block.origin.z()) /
                                  kBlockDim -
                              blockMin_;
@@ -62,41 +68,15 @@ FiberMedium::FiberMedium(const FiberGrid& grid)
                     std::size_t(c.z)] = static_cast<std::int32_t>(b);
         std::uint16_t count = 0;
         for (int w = 0; w < 8; ++w) {
-            prefix_[b][std::size_t(w)] = count;
-            count = static_cast<std::uint16_t>(
-                count + openvdb::util::CountOn(block.active.getWord<Word>(openvdb::Index(w))));
+            const Word word = block.active.getWord<Word>(openvdb::Index(w));
+            mb.words[std::size_t(w)] = word;
+            mb.prefix[std::size_t(w)] = count;
+            count = static_cast<std::uint16_t>(count + openvdb::util::CountOn(word));
         }
         const Vec3f lo3 = (Vec3f(block.origin.x(), block.origin.y(), block.origin.z()) - 0.5f) * h_;
         bounds_.extend(lo3);
         bounds_.extend(lo3 + float(kBlockDim) * h_);
     }
-}
-
-std::int32_t FiberMedium::blockAt(const glm::ivec3& c) const {
-    const glm::ivec3 b = c - blockMin_;
-    if (b.x < 0 || b.y < 0 || b.z < 0 || b.x >= blockDims_.x || b.y >= blockDims_.y ||
-        b.z >= blockDims_.z)
-        return -1;
-    return blockIndex_[(std::size_t(b.x) * std::size_t(blockDims_.y) + std::size_t(b.y)) *
-                           std::size_t(blockDims_.z) +
-                       std::size_t(b.z)];
-}
-
-glm::ivec3 FiberMedium::blockOrigin(std::int32_t block) const {
-    const openvdb::Coord& o = grid_->blocks[std::size_t(block)].origin;
-    return {o.x(), o.y(), o.z()};
-}
-
-std::int64_t FiberMedium::voxelIn(std::int32_t block, const glm::ivec3& v) const {
-    const FiberBlock& fb = grid_->blocks[std::size_t(block)];
-    const auto offset = static_cast<openvdb::Index>(((v.x & 7) << 6) | ((v.y & 7) << 3) | (v.z & 7));
-    using Word = openvdb::Index64;
-    const Word word = fb.active.getWord<Word>(offset >> 6);
-    const Word bit = Word(1) << (offset & 63);
-    if (!(word & bit))
-        return -1;
-    return std::int64_t(fb.first) + prefix_[std::size_t(block)][offset >> 6] +
-           std::popcount(word & (bit - 1));
 }
 
 std::int64_t FiberMedium::voxelAt(const Vec3f& q) const {
@@ -105,21 +85,22 @@ std::int64_t FiberMedium::voxelAt(const Vec3f& q) const {
     return block < 0 ? -1 : voxelIn(block, v);
 }
 
-float FiberMedium::meanCosTheta(std::size_t v, const Vec3f& omega) const {
-    // c·cos θ(ω, o/c) = |ω × o|, so the blend needs no normalisation.
-    const Vec3f o(grid_->orientation[v].x(), grid_->orientation[v].y(), grid_->orientation[v].z());
-    const float c = std::min(1.0f, glm::length(o));
-    return glm::length(glm::cross(omega, o)) + (1.0f - c) * kQuarterPi;
+std::uint64_t FiberMedium::memoryBytes() const {
+    return voxels_.capacity() * sizeof(VoxelMedium) +
+           blockIndex_.capacity() * sizeof(std::int32_t) + blocks_.capacity() * sizeof(MediumBlock);
 }
 
 float FiberMedium::extinction(const Vec3f& x, const Vec3f& omega) const {
     const std::int64_t v = voxelAt(x / h_ + 0.5f);
-    return v < 0 ? 0.0f : kD_ * grid_->density[std::size_t(v)] * meanCosTheta(std::size_t(v), omega);
+    if (v < 0)
+        return 0.0f;
+    const VoxelMedium& m = voxels_[std::size_t(v)];
+    return kD_ * m.lambda * meanCosTheta(m, omega);
 }
 
 void FiberMedium::sampleFiber(std::size_t v, const Vec3f& omega, Pcg32& rng,
                               MediumCollision& out) const {
-    const Vec3f o(grid_->orientation[v].x(), grid_->orientation[v].y(), grid_->orientation[v].z());
+    const Vec3f& o = voxels_[v].o;
     const float len = glm::length(o);
     const float c = std::min(1.0f, len);
     const float coherent = glm::length(glm::cross(omega, o));

@@ -247,7 +247,8 @@ private:
 
     /// A flight's crossings (FiberMedium::sampleCollision's `crossed`): ∫ λ dt
     /// over each run of its voxels in one cell, the λ without the share of
-    /// the fiber it leaves (fiber_medium.h).
+    /// the fiber it leaves (fiber_medium.h). A cell's slot is looked up once
+    /// a run, not once a voxel.
     class Deposits {
     public:
         Deposits(const PathTracer& tracer, ChunkRecord& record)
@@ -256,10 +257,11 @@ private:
             , flight_(static_cast<std::uint32_t>(record.flights.size()))
             , first_(record.crossings.size()) {}
         void operator()(std::size_t, const glm::ivec3& ijk, float lambda, float t0, float t1) {
-            const std::int64_t s = cache_.slotOfVoxel(ijk);
-            if (s != slot_) {
+            const glm::ivec3 cell = cache_.cells().cellOfVoxel(ijk);
+            if (cell != cell_) {
                 flush();
-                slot_ = s;
+                cell_ = cell;
+                slot_ = cache_.cells().slotOfCell(cell);
                 sum_ = 0;
             }
             sum_ += lambda * (t1 - t0);
@@ -280,6 +282,7 @@ private:
         ChunkRecord& record_;
         std::uint32_t flight_;
         std::size_t first_;
+        glm::ivec3 cell_{std::numeric_limits<int>::min()}; ///< of the run being summed
         std::int64_t slot_ = -1;
         float sum_ = 0;
     };
@@ -366,9 +369,14 @@ MultipleScatteringSolution solveMultipleScattering(const VolumetricScene& scene,
     const ThreadLimit threadLimit(settings.threads);
     const auto start = Clock::now();
 
+    // The medium's records first (32 bytes a voxel, twice the grid's λ and o
+    // that the render's budget already holds); the cache gets what is left.
+    const FiberMedium medium(*scene.grid);
+    const std::uint64_t cacheBudget =
+        memoryBudget > medium.memoryBytes() ? memoryBudget - medium.memoryBytes() : 1;
     MultipleScatteringSolution out;
     VolumetricStats& stats = out.stats;
-    out.cache = std::make_unique<RadianceCache>(*scene.grid, settings.cache, memoryBudget);
+    out.cache = std::make_unique<RadianceCache>(*scene.grid, settings.cache, cacheBudget);
     RadianceCache& cache = *out.cache;
     stats.cells = cache.cellCount();
     stats.pathsPerLight.assign(scene.lights.size(), 0);
@@ -381,7 +389,6 @@ MultipleScatteringSolution solveMultipleScattering(const VolumetricScene& scene,
         stats.surfaceCells = out.surfaces->cellCount();
     }
 
-    const FiberMedium medium(*scene.grid);
     std::unique_ptr<RayScene> rays;
     if (settings.transport == VolumetricTransport::Fibers) {
         if (!scene.groom)
@@ -446,6 +453,14 @@ MultipleScatteringSolution solveMultipleScattering(const VolumetricScene& scene,
                 const ChunkRecord& r = records[k];
                 for (std::uint32_t i = r.bucketStart[b]; i < r.bucketStart[b + 1]; ++i) {
                     const Crossing& x = r.crossings[i];
+                    // The next crossing's cell and basis on their way while this one adds.
+                    if (i + 1 < r.bucketStart[b + 1]) {
+                        const Crossing& next = r.crossings[i + 1];
+                        cache.prefetch(next.slot);
+                        const float* y = r.basis.data() + std::size_t(next.flight) * nc;
+                        for (std::size_t j = 0; j < nc; j += 16)
+                            __builtin_prefetch(y + j);
+                    }
                     cache.deposit(x.slot, r.basis.data() + std::size_t(x.flight) * nc,
                                   r.flights[x.flight].power * x.weight);
                 }

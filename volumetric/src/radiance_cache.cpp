@@ -128,10 +128,6 @@ std::uint64_t RadianceCache::memoryBytes() const {
     return bytes;
 }
 
-std::int64_t RadianceCache::slotOfVoxel(const glm::ivec3& v) const {
-    return grid_.slotOfCell(grid_.cellOfVoxel(v));
-}
-
 void RadianceCache::deposit(std::uint32_t slot, const Vec3f& omega_i, const Rgb& sample) {
     std::array<float, SphericalHarmonics::kMaxCoefficients> y;
     SphericalHarmonics::evaluate(omega_i, settings_.shOrder, y.data());

@@ -13,6 +13,7 @@
 #include <hairvox/core/grid_traversal.h>
 #include <hairvox/core/vecmath.h>
 
+#include <bit>
 #include <cstdint>
 #include <vector>
 
@@ -23,7 +24,13 @@ public:
     CellGrid() = default;
     /// The box of cells [cellMin, cellMin + dims), none present yet.
     CellGrid(float voxelSize, int cellVoxels, const glm::ivec3& cellMin, const glm::ivec3& dims)
-        : h_(voxelSize), m_(cellVoxels), min_(cellMin), dims_(dims) {}
+        : h_(voxelSize)
+        , m_(cellVoxels)
+        , shift_(cellVoxels > 0 && std::has_single_bit(unsigned(cellVoxels))
+                     ? std::countr_zero(unsigned(cellVoxels))
+                     : -1)
+        , min_(cellMin)
+        , dims_(dims) {}
 
     float voxelSize() const { return h_; }
     int cellVoxels() const { return m_; }
@@ -41,6 +48,8 @@ public:
     }
     /// The cell holding voxel v (index space).
     glm::ivec3 cellOfVoxel(const glm::ivec3& v) const {
+        if (shift_ >= 0) // m = 2^shift: ⌊v/m⌋ is the arithmetic shift (C++20), no division
+            return {v.x >> shift_, v.y >> shift_, v.z >> shift_};
         return {floorDiv(v.x, m_), floorDiv(v.y, m_), floorDiv(v.z, m_)};
     }
     /// The cell's place in the box's dense order (x slowest), or −1 outside.
@@ -114,6 +123,7 @@ private:
 
     float h_ = 1;
     int m_ = 1;
+    int shift_ = 0; ///< log2 m if m is a power of two, else −1
     glm::ivec3 min_{0}, dims_{0};
     std::vector<std::int32_t> index_; ///< dense over the box: slot or −1
 };

@@ -107,9 +107,6 @@ public:
     const CellGrid& cells() const { return grid_; }
     std::uint64_t memoryBytes() const;
 
-    /// The slot of the cell holding voxel v (index space), or -1.
-    std::int64_t slotOfVoxel(const glm::ivec3& v) const;
-
     /// Adds to the cell's incident radiance a sample of Λ·L̄ (radiance ×
     /// solid angle × fiber length) arriving from unit ω_i (pointing away from
     /// the cell, toward where the light comes from): sample/Λ in the basis.
@@ -118,6 +115,13 @@ public:
     /// The same with ω_i's basis values Y_lm(ω_i) given ((L + 1)² floats,
     /// SphericalHarmonics::evaluate): a flight deposits into several cells.
     void deposit(std::uint32_t slot, const float* y, const Rgb& sample);
+    /// Asks for the cell's coefficients to be brought into the cache ahead of
+    /// a deposit() to it (a hint: changes nothing else).
+    void prefetch(std::uint32_t slot) const {
+        const float* c = coefficients_.data() + std::size_t(slot) * floatsPerCell();
+        for (std::size_t i = 0; i < floatsPerCell(); i += 16)
+            __builtin_prefetch(c + i, 1);
+    }
 
     /// Ends the deposits; `kernels[t]` is fiber type t's scattering kernel
     /// (of the cache's SH order).

@@ -22,6 +22,8 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <type_traits>
+#include <utility>
 
 namespace hairvox {
 
@@ -34,10 +36,32 @@ struct SphericalHarmonics {
 
     /// Y_lm(ω) for l ≤ order into y[index(l, m)] (unit ω).
     static void evaluate(const Vec3f& omega, int order, float* y) {
+        // kMaxOrder (the cache's default) with its loops unrolled at compile
+        // time: the same operations, a third of the instructions (callgrind:
+        // a flight's basis and record ~1,800 → ~600).
+        if (order == kMaxOrder)
+            evaluateTo(omega, std::integral_constant<int, kMaxOrder>{}, y);
+        else
+            evaluateTo(omega, order, y);
+    }
+
+    /// K_lm.
+    static double normalisation(int l, int m) {
+        double ratio = 1; // (l − m)!/(l + m)!
+        for (int i = l - m + 1; i <= l + m; ++i)
+            ratio /= double(i);
+        return std::sqrt(double(2 * l + 1) / (4.0 * Pi) * ratio);
+    }
+
+private:
+    /// evaluate() to `order`, an int or a std::integral_constant (then every
+    /// loop is unrolled and every index a constant).
+    template <typename Order>
+    static void evaluateTo(const Vec3f& omega, Order order, float* y) {
         const float x = omega.x, yy = omega.y, z = omega.z;
         // Re, Im of (x + iy)^m, and Q_m^m = (2m − 1)!!, from m = 0 up.
         float re = 1, im = 0, qmm = 1;
-        for (int m = 0; m <= order; ++m) {
+        forEach(std::integral_constant<int, 0>{}, order, [&](auto m) {
             if (m > 0) {
                 const float r = re * x - im * yy;
                 im = re * yy + im * x;
@@ -45,7 +69,7 @@ struct SphericalHarmonics {
                 qmm *= float(2 * m - 1);
             }
             float q2 = 0, q1 = qmm; // Q_{l−2}^m, Q_{l−1}^m, starting at l = m
-            for (int l = m; l <= order; ++l) {
+            forEach(m, order, [&](auto l) {
                 float q;
                 if (l == m)
                     q = qmm;
@@ -65,19 +89,25 @@ struct SphericalHarmonics {
                     y[index(l, m)] = k * q * re;
                     y[index(l, -m)] = k * q * im;
                 }
-            }
+            });
+        });
+    }
+    /// f(i) for i = first … last: a loop, or, for compile-time bounds, f of
+    /// each std::integral_constant in turn.
+    template <typename F>
+    static void forEach(int first, int last, F&& f) {
+        for (int i = first; i <= last; ++i)
+            f(i);
+    }
+    template <int First, int Last, typename F>
+    static void forEach(std::integral_constant<int, First>, std::integral_constant<int, Last>,
+                        F&& f) {
+        [&]<int... I>(std::integer_sequence<int, I...>) {
+            (f(std::integral_constant<int, First + I>{}), ...);
         }
+        (std::make_integer_sequence<int, Last - First + 1>{});
     }
 
-    /// K_lm.
-    static double normalisation(int l, int m) {
-        double ratio = 1; // (l − m)!/(l + m)!
-        for (int i = l - m + 1; i <= l + m; ++i)
-            ratio /= double(i);
-        return std::sqrt(double(2 * l + 1) / (4.0 * Pi) * ratio);
-    }
-
-private:
     /// K_l0, and √2·K_lm for m > 0, at index(l, m).
     static inline const std::array<float, kMaxCoefficients> kNormalisation = [] {
         std::array<float, kMaxCoefficients> k{};
