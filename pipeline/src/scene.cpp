@@ -672,6 +672,8 @@ Scene parseScene(const nlohmann::json& document, const std::string& sourceName,
             });
             set("denoise", volumetric,
                 [&](const JsonValue& x) { vol.cache.denoise = x.boolean(); });
+            set("gradients", volumetric,
+                [&](const JsonValue& x) { vol.cache.gradients = x.boolean(); });
             set("transport", volumetric,
                 [&](const JsonValue& x) { vol.transport = x.oneOf(kVolumetricTransportNames); });
             in.finish();

@@ -5,14 +5,17 @@
 #include <hairvox/core/sampling.h>
 #include <hairvox/shading/marschner.h>
 #include <hairvox/volumetric/radiance_cache.h>
+#include <hairvox/volumetric/spherical_harmonics.h>
 #include <hairvox/voxelize/fiber_grid.h>
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <iostream>
 #include <numeric>
 #include <utility>
+#include <vector>
 
 namespace hairvox {
 namespace {
@@ -137,6 +140,57 @@ TEST(RadianceCache, ReadsShrinkTheBandsTheFlightsCouldNotResolve) {
     // edge in both).
     EXPECT_NEAR(peakDenoised.g, peakRaw.g, 0.02f * peakRaw.g);
     EXPECT_GT(peakRaw.g, 5.0f);
+}
+
+TEST(RadianceCache, ReadsFollowEachCellsSlopeOfMeanRadiance) {
+    // The slab's fibers (y in [0, 1 cm]) lit by light that grows across it,
+    // L(y) = 1 + 100·y, deposited where the fibers receive it: in proportion
+    // to each voxel's fiber length λ_v·h³, at the 8 points ±h/(2√3) about its
+    // vertex (its box's mean and variance, as the solve's tracks have them on
+    // average), each from a random direction.
+    test::Slab slab;
+    slab.fibers = 2000;
+    const double h = 0.002;
+    const FiberGrid grid = test::splatSlab(slab, h);
+    RadianceCacheSettings withSlopes, without;
+    without.gradients = false;
+    RadianceCache a(grid, withSlopes, 1ull << 30), b(grid, without, 1ull << 30);
+    const auto field = [](const Vec3f& x) { return 1.0f + 100.0f * x.y; };
+    Pcg32 rng(5);
+    std::array<float, SphericalHarmonics::kMaxCoefficients> y;
+    const float spread = float(h / (2.0 * std::sqrt(3.0)));
+    grid.forEachVoxel([&](std::size_t v, const openvdb::Coord& ijk) {
+        for (int k = 0; k < 8; ++k) {
+            const Vec3f x = Vec3f(float(ijk.x()), float(ijk.y()), float(ijk.z())) * float(h) +
+                            spread * Vec3f(k & 1 ? 1 : -1, k & 2 ? 1 : -1, k & 4 ? 1 : -1);
+            const auto slot = std::uint32_t(a.slotAt(x));
+            SphericalHarmonics::evaluate(uniformSphere(rng.uniformFloat(), rng.uniformFloat()),
+                                         withSlopes.shOrder, y.data());
+            const Rgb sample(field(x) * float(4.0 * Pi) * grid.density[v] * float(h * h * h) /
+                             8.0f);
+            a.deposit(slot, y.data(), sample, x - a.cellCentre(slot));
+            b.deposit(slot, y.data(), sample, x - b.cellCentre(slot));
+        }
+    });
+    a.finish({});
+    b.finish({});
+    const auto none = [](const Vec3f&) { return 0.0f; }; // readError's mean alone
+    // Inside, both read the field (trilinear between cells is exact for a
+    // linear field); near the slab's top, beyond its last cells' centroids,
+    // only the slopes do.
+    for (const float height : {0.005f, 0.0095f}) {
+        const Vec3f x(0.001f, height, 0.0f);
+        const double slopes = readError(a, x, none).second,
+                     means = readError(b, x, none).second, truth = double(field(x));
+        std::cout << "L(y) = 1 + 100 y at y = " << height << ": " << truth << ", read "
+                  << slopes << " with the cells' slopes, " << means << " without\n";
+        // Measured (truth / slopes / without): 1.5 / 1.5001 / 1.519 at 5 mm,
+        // 1.95 / 1.9501 / 1.871 at 9.5 mm.
+        EXPECT_NEAR(slopes, truth, 0.02 * truth) << height;
+        if (height > 0.009f) {
+            EXPECT_GT(std::abs(means - truth), 2.0 * std::abs(slopes - truth));
+        }
+    }
 }
 
 TEST(RadianceCache, UniformIncidentLightLeavesAsTheFibersAlbedo) {

@@ -57,7 +57,8 @@ struct Flight {
 struct Crossing {
     std::uint32_t slot;
     std::uint32_t flight; ///< in the chunk's flights
-    float weight; ///< ∫ λ dt over the cell's voxels the flight crosses
+    float weight;         ///< ∫ λ dt over the cell's voxels the flight crosses
+    Vec3f offset;         ///< ∫ λ·(x − the cell's centre) dt / weight (radiance_cache.h)
 };
 /// A scattered path's power arriving on a surface.
 struct SurfaceDeposit {
@@ -182,7 +183,7 @@ private:
                 tSurface = surface ? surface->t : std::numeric_limits<float>::infinity();
                 // From its first scattering on, the flight's deposits ride along.
                 if (scattered) {
-                    Deposits deposits(*this, record);
+                    Deposits deposits(*this, record, ray);
                     hit = medium_.sampleCollision(ray.origin, ray.dir, tSurface, rng,
                                                   own ? &*own : nullptr, deposits);
                     deposits.finish(ray.dir, power);
@@ -251,8 +252,9 @@ private:
     /// a run, not once a voxel.
     class Deposits {
     public:
-        Deposits(const PathTracer& tracer, ChunkRecord& record)
-            : cache_(tracer.cache_)
+        Deposits(const PathTracer& tracer, ChunkRecord& record, const Ray& ray)
+            : ray_(ray)
+            , cache_(tracer.cache_)
             , record_(record)
             , flight_(static_cast<std::uint32_t>(record.flights.size()))
             , first_(record.crossings.size()) {}
@@ -263,8 +265,11 @@ private:
                 cell_ = cell;
                 slot_ = cache_.cells().slotOfCell(cell);
                 sum_ = 0;
+                moment_ = Vec3f(0.0f);
             }
-            sum_ += lambda * (t1 - t0);
+            const float weight = lambda * (t1 - t0);
+            sum_ += weight;
+            moment_ += weight * (ray_.origin + (0.5f * (t0 + t1)) * ray_.dir);
         }
         /// Ends the flight: its record, if it crossed any cell.
         void finish(const Vec3f& dir, const Rgb& power) {
@@ -276,8 +281,10 @@ private:
     private:
         void flush() {
             if (slot_ >= 0 && sum_ > 0)
-                record_.crossings.push_back({std::uint32_t(slot_), flight_, sum_});
+                record_.crossings.push_back({std::uint32_t(slot_), flight_, sum_,
+                                             moment_ / sum_ - cache_.cells().centre(cell_)});
         }
+        const Ray& ray_;
         const RadianceCache& cache_;
         ChunkRecord& record_;
         std::uint32_t flight_;
@@ -285,13 +292,14 @@ private:
         glm::ivec3 cell_{std::numeric_limits<int>::min()}; ///< of the run being summed
         std::int64_t slot_ = -1;
         float sum_ = 0;
+        Vec3f moment_{0.0f}; ///< ∫ λ·x dt of the run
     };
 
     /// The fibers transport's flight origin + t·dir, t ∈ [0, tEnd], into the
     /// cells it crosses (the strands themselves are met by rays: no fiber is
     /// left out of λ).
     void depositAlong(const Ray& ray, float tEnd, const Rgb& power, ChunkRecord& record) const {
-        Deposits deposits(*this, record);
+        Deposits deposits(*this, record, ray);
         medium_.walkVoxels(ray.origin, ray.dir, tEnd,
                            [&](std::size_t v, const glm::ivec3& ijk, float t0, float t1) {
                                deposits(v, ijk, medium_.grid().density[v], t0, t1);
@@ -339,7 +347,7 @@ void VolumetricSettings::validate() const {
 
 void VolumetricSettings::hashInto(Hasher& h) const {
     h.value(paths).value(pathsPerCell).value(cache.shOrder);
-    h.value(cache.cellVoxels).value(cache.denoise).value(maxDepth).value(rouletteDepth).value(seed).value(transport);
+    h.value(cache.cellVoxels).value(cache.denoise).value(cache.gradients).value(maxDepth).value(rouletteDepth).value(seed).value(transport);
 }
 
 std::ostream& operator<<(std::ostream& os, const VolumetricSettings& s) {
@@ -462,7 +470,7 @@ MultipleScatteringSolution solveMultipleScattering(const VolumetricScene& scene,
                             __builtin_prefetch(y + j);
                     }
                     cache.deposit(x.slot, r.basis.data() + std::size_t(x.flight) * nc,
-                                  r.flights[x.flight].power * x.weight);
+                                  r.flights[x.flight].power * x.weight, x.offset);
                 }
             }
         });

@@ -5,6 +5,9 @@
 #include <hairvox/volumetric/spherical_harmonics.h>
 #include <hairvox/voxelize/fiber_grid.h>
 
+#include <glm/gtc/matrix_inverse.hpp>
+#include <glm/matrix.hpp>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -48,7 +51,7 @@ void RadianceCacheSettings::validate() const {
 
 std::ostream& operator<<(std::ostream& os, const RadianceCacheSettings& s) {
     return os << "RadianceCacheSettings(shOrder=" << s.shOrder << ", cellVoxels=" << s.cellVoxels
-              << ", denoise=" << s.denoise << ")";
+              << ", denoise=" << s.denoise << ", gradients=" << s.gradients << ")";
 }
 
 std::uint64_t RadianceCache::estimateBytes(const FiberGrid& grid,
@@ -61,7 +64,8 @@ std::uint64_t RadianceCache::estimateBytes(const FiberGrid& grid,
     // Occupied cells at most: one per active voxel, or the whole box.
     const std::uint64_t cells = std::min<std::uint64_t>(grid.activeVoxelCount(), boxCells(dims));
     const std::uint64_t perCell =
-        4 * 3 * (std::uint64_t(settings.coefficients()) + 1) + sizeof(glm::ivec3) + sizeof(float);
+        4 * 3 * (std::uint64_t(settings.coefficients()) + 1) + sizeof(glm::ivec3) + sizeof(float) +
+        sizeof(CellShape) + 3 * sizeof(Vec3f);
     return boxCells(dims) * 4 + cells * perCell;
 }
 
@@ -106,8 +110,29 @@ RadianceCache::RadianceCache(const FiberGrid& grid, const RadianceCacheSettings&
     for (std::size_t s = 0; s < cells_.size(); ++s)
         fiberLength_[s] = float(sumL[s] * voxelVolume);
 
+    // The fibers' centroid and the covariance of their positions, λ-weighted,
+    // a voxel's value holding over the box around its vertex (h²/12 an axis).
+    std::vector<glm::dvec3> sumX(cells_.size(), glm::dvec3(0.0));
+    std::vector<glm::dmat3> sumXX(cells_.size(), glm::dmat3(0.0));
+    grid.forEachVoxel([&](std::size_t v, const openvdb::Coord& ijk) {
+        const std::size_t s = std::size_t(grid_.slotOfCell(cellOfVoxel(ijk)));
+        const glm::dvec3 x = glm::dvec3(ijk.x(), ijk.y(), ijk.z()) * h;
+        sumX[s] += double(grid.density[v]) * x;
+        sumXX[s] += double(grid.density[v]) * glm::outerProduct(x, x);
+    });
+    shapes_.resize(cells_.size());
+    for (std::size_t s = 0; s < cells_.size(); ++s) {
+        const glm::dvec3 centroid =
+            sumL[s] > 0 ? sumX[s] / sumL[s] : glm::dvec3(grid_.centre(cells_[s]));
+        glm::dmat3 covariance = glm::dmat3(h * h / 12.0);
+        if (sumL[s] > 0)
+            covariance += sumXX[s] / sumL[s] - glm::outerProduct(centroid, centroid);
+        shapes_[s] = {Vec3f(centroid), glm::mat3(glm::inverse(covariance))};
+    }
+
     coefficients_.assign(cells_.size() * floatsPerCell(), 0.0f);
     secondMoment_.assign(cells_.size() * 3, 0.0f);
+    slopes_.assign(cells_.size() * 3, Vec3f(0.0f));
 }
 
 Bounds3f RadianceCache::bounds() const {
@@ -124,23 +149,27 @@ std::uint64_t RadianceCache::memoryBytes() const {
     std::uint64_t bytes = grid_.memoryBytes() + cells_.capacity() * sizeof(glm::ivec3) +
                           fiberLength_.capacity() * sizeof(float) +
                           coefficients_.size() * sizeof(float) +
-                          secondMoment_.capacity() * sizeof(float);
+                          secondMoment_.capacity() * sizeof(float) +
+                          shapes_.capacity() * sizeof(CellShape) +
+                          slopes_.capacity() * sizeof(Vec3f);
     return bytes;
 }
 
 void RadianceCache::deposit(std::uint32_t slot, const Vec3f& omega_i, const Rgb& sample) {
     std::array<float, SphericalHarmonics::kMaxCoefficients> y;
     SphericalHarmonics::evaluate(omega_i, settings_.shOrder, y.data());
-    deposit(slot, y.data(), sample);
+    deposit(slot, y.data(), sample, shapes_[slot].centroid - grid_.centre(cells_[slot]));
 }
 
-void RadianceCache::deposit(std::uint32_t slot, const float* y, const Rgb& sample) {
+void RadianceCache::deposit(std::uint32_t slot, const float* y, const Rgb& sample,
+                            const Vec3f& offset) {
     const int nc = settings_.coefficients();
     float* c = coefficients_.data() + std::size_t(slot) * floatsPerCell();
     const float inv = 1.0f / fiberLength_[slot];
     for (int ch = 0; ch < 3; ++ch) {
         const float w = sample[ch] * inv;
         secondMoment_[std::size_t(slot) * 3 + std::size_t(ch)] += w * w;
+        slopes_[std::size_t(slot) * 3 + std::size_t(ch)] += (w * y[0]) * offset;
         float* cc = c + ch * nc;
         for (int m = 0; m < nc; ++m)
             cc[m] += w * y[m];
@@ -153,18 +182,38 @@ void RadianceCache::finish(std::vector<ScatteringKernel> kernels) {
             throw std::invalid_argument("RadianceCache::finish: a kernel of another SH order");
     kernels_ = std::move(kernels);
     finished_ = true;
+    // The slopes from the first moments (see Gradients): β = Σ⁻¹(m − c_00·(x̄ − x_c)).
+    const int nc = settings_.coefficients();
+    for (std::size_t s = 0; s < cells_.size(); ++s) {
+        const Vec3f shift = shapes_[s].centroid - grid_.centre(cells_[s]);
+        for (std::size_t ch = 0; ch < 3; ++ch) {
+            const float c00 = coefficients_[s * floatsPerCell() + ch * std::size_t(nc)];
+            Vec3f& slope = slopes_[s * 3 + ch];
+            slope = shapes_[s].covarianceInverse * (slope - c00 * shift);
+        }
+    }
 }
 
 bool RadianceCache::blend(const Vec3f& x, float* out) const {
     const std::size_t n = floatsPerCell();
     std::fill(out, out + n, 0.0f);
-    Rgb moment(0.0f); // Σ_i w_i²·Σ_f w_f² of the cells blended
+    Rgb moment(0.0f); // Σ_i w_i²·Σ_f w_f² of the cells blended (each as scaled)
+    const std::size_t perChannel = std::size_t(settings_.coefficients());
+    const bool slopes = settings_.gradients && finished_;
     const float weights = grid_.forEachAround(x, [&](std::size_t slot, float w) {
         const float* c = coefficients_.data() + slot * n;
-        for (std::size_t i = 0; i < n; ++i)
-            out[i] += w * c[i];
-        for (std::size_t ch = 0; ch < 3; ++ch)
-            moment[int(ch)] += w * w * secondMoment_[slot * 3 + ch];
+        for (std::size_t ch = 0; ch < 3; ++ch) {
+            // The cell's level at x (see Gradients), within [½, 2] of its mean.
+            float level = 1;
+            if (const float c00 = c[ch * perChannel]; slopes && c00 > 0) {
+                const float at = c00 + glm::dot(slopes_[slot * 3 + ch], x - shapes_[slot].centroid);
+                level = std::clamp(at / c00, 0.5f, 2.0f);
+            }
+            const float wl = w * level;
+            for (std::size_t i = ch * perChannel; i < (ch + 1) * perChannel; ++i)
+                out[i] += wl * c[i];
+            moment[int(ch)] += wl * wl * secondMoment_[slot * 3 + ch];
+        }
     });
     if (!(weights > 0))
         return false;
