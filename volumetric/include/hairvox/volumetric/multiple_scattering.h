@@ -11,7 +11,8 @@
 // hair's scattered light lights the skin through the cache's irradiance).
 // From its first scattering on, every flight of a path deposits into the
 // cells it crosses the λ-weighted track-length estimate of their radiance
-// (Φ·∫λ dt/Λ, at the flight's direction; radiance_cache.h; λ without the
+// (Φ·∫λ dt/Λ, at the flight's direction and the λ-weighted mean of the
+// track's points, for the cell's gradient; radiance_cache.h; λ without the
 // share of the fiber the flight leaves, which it neither meets nor lights:
 // fiber_medium.h), and where it
 // meets a surface its power onto the surface (surface_irradiance.h): the

@@ -184,8 +184,9 @@ public:
 private:
     std::size_t floatsPerCell() const { return 3 * std::size_t(settings_.coefficients()); }
     /// The coefficients blended trilinearly over the cells around x into
-    /// `out` (floatsPerCell() floats), each band shrunk by its noise where
-    /// settings().denoise; false where no cell is.
+    /// `out` (floatsPerCell() floats), each cell at its level at x where
+    /// settings().gradients and finish() has run, each band shrunk by its
+    /// noise where settings().denoise; false where no cell is.
     bool blend(const Vec3f& x, float* out) const;
 
     RadianceCacheSettings settings_;
