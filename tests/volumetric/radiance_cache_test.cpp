@@ -1,4 +1,5 @@
 #include "../transmittance/slab.h"
+#include "sphere_midpoints.h"
 
 #include <hairvox/core/error.h>
 #include <hairvox/core/math.h>
@@ -69,21 +70,16 @@ TEST(RadianceCache, DepositsProjectTheIncidentField) {
 }
 
 /// The RMS over directions of a cell's read field against `field`, and its
-/// mean (midpoints in z = cos and φ: exact for the orders a cache holds).
+/// mean (test::forEachSphereMidpoint: exact for the orders a cache holds).
 template <typename F>
 std::pair<double, double> readError(const RadianceCache& cache, const Vec3f& x, F&& field) {
     double squares = 0, mean = 0;
     const int n = 64;
-    for (int a = 0; a < n; ++a)
-        for (int b = 0; b < n; ++b) {
-            const float z = -1.0f + (float(a) + 0.5f) * 2.0f / float(n);
-            const float phi = (float(b) + 0.5f) * float(TwoPi) / float(n);
-            const float r = std::sqrt(1.0f - z * z);
-            const Vec3f w(r * std::cos(phi), r * std::sin(phi), z);
-            const double got = double(cache.incident(x, w).g);
-            squares += (got - double(field(w))) * (got - double(field(w)));
-            mean += got;
-        }
+    test::forEachSphereMidpoint(n, [&](const Vec3f& w) {
+        const double got = double(cache.incident(x, w).g);
+        squares += (got - double(field(w))) * (got - double(field(w)));
+        mean += got;
+    });
     return {std::sqrt(squares / (n * n)), mean / (n * n)};
 }
 
@@ -202,16 +198,11 @@ TEST(RadianceCache, UniformIncidentLightLeavesAsTheFibersAlbedo) {
     // Every cell lit by uniform radiance 1 from every direction: a regular
     // grid of directions, uniform in s = ω_z and φ.
     for (std::size_t s = 0; s < cache.cellCount(); ++s) {
-        const int ns = 64, nphi = 64;
-        for (int a = 0; a < ns; ++a)
-            for (int b = 0; b < nphi; ++b) {
-                const float z = -1.0f + (float(a) + 0.5f) * 2.0f / float(ns);
-                const float phi = (float(b) + 0.5f) * float(TwoPi) / float(nphi);
-                const float r = std::sqrt(1.0f - z * z);
-                const Vec3f w(r * std::cos(phi), r * std::sin(phi), z);
-                cache.deposit(std::uint32_t(s), w,
-                              Rgb(float(4.0 * Pi) / float(ns * nphi) * cache.fiberLength(s)));
-            }
+        const int n = 64;
+        test::forEachSphereMidpoint(n, [&](const Vec3f& w) {
+            cache.deposit(std::uint32_t(s), w,
+                          Rgb(float(4.0 * Pi) / float(n * n) * cache.fiberLength(s)));
+        });
     }
     FiberParams fiber;
     const MarschnerBcsdf bcsdf(fiber);

@@ -347,7 +347,13 @@ void VolumetricSettings::validate() const {
 
 void VolumetricSettings::hashInto(Hasher& h) const {
     h.value(paths).value(pathsPerCell).value(cache.shOrder);
-    h.value(cache.cellVoxels).value(cache.denoise).value(cache.gradients).value(maxDepth).value(rouletteDepth).value(seed).value(transport);
+    h.value(cache.cellVoxels)
+        .value(cache.denoise)
+        .value(cache.gradients)
+        .value(maxDepth)
+        .value(rouletteDepth)
+        .value(seed)
+        .value(transport);
 }
 
 std::ostream& operator<<(std::ostream& os, const VolumetricSettings& s) {
@@ -377,8 +383,8 @@ MultipleScatteringSolution solveMultipleScattering(const VolumetricScene& scene,
     const ThreadLimit threadLimit(settings.threads);
     const auto start = Clock::now();
 
-    // The medium's records first (32 bytes a voxel, twice the grid's λ and o
-    // that the render's budget already holds); the cache gets what is left.
+    // The medium's records first (16 bytes a voxel, a copy of the grid's λ
+    // and o, and its block table); the cache gets what is left.
     const FiberMedium medium(*scene.grid);
     const std::uint64_t cacheBudget =
         memoryBudget > medium.memoryBytes() ? memoryBudget - medium.memoryBytes() : 1;
